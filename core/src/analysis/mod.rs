@@ -1,0 +1,1 @@
+//! Pressure drop, time averages, particle-based averages.

@@ -1,0 +1,437 @@
+//! The case: what a user submits, as serde types with units in the field names.
+//! Defaults are the paper's Table 1 (contacts) and section 3 (the 44-mm bed, d = 1.2 mm).
+//! A case without a `gas` section runs DEM alone.
+
+mod validate;
+
+pub use validate::{Problem, Severity, ValidationReport};
+
+use schemars::JsonSchema;
+use serde::{Deserialize, Serialize};
+
+/// A complete simulation case.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Free-form name shown in job listings.
+    #[serde(default)]
+    pub name: String,
+    pub column: Column,
+    pub particles: Particles,
+    pub bed: Bed,
+    /// Magnitude of gravity, acting along -z.
+    #[serde(default = "d_gravity")]
+    pub gravity_m_s2: f64,
+    #[serde(default)]
+    pub dem: Dem,
+    /// Simulated time at which the run ends.
+    #[serde(default = "d_end_time")]
+    pub end_time_s: f64,
+    #[serde(default)]
+    pub outputs: Outputs,
+    /// The gas phase; absent means DEM only.
+    #[serde(default)]
+    pub gas: Option<Gas>,
+    /// The cylindrical fluid grid (used when `gas` is present).
+    #[serde(default)]
+    pub grid: Grid,
+    /// How particle volume becomes cell voidage.
+    #[serde(default)]
+    pub voidage: Voidage,
+}
+
+/// The cylindrical column (tube). Its axis is the z axis, the distributor plate is z = 0.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Column {
+    pub diameter_m: f64,
+    pub height_m: f64,
+    /// Close the top with a wall at z = height_m (particles bounce off it).
+    #[serde(default)]
+    pub lid: bool,
+}
+
+impl Default for Column {
+    fn default() -> Self {
+        Column { diameter_m: 0.044, height_m: 0.12, lid: false }
+    }
+}
+
+/// Normal or tangential damping: Tsuji's α, or a restitution coefficient converted to α.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Damping {
+    TsujiAlpha(f64),
+    Restitution(f64),
+}
+
+impl Damping {
+    /// Tsuji α. Restitution e maps to α = √5 |ln e| / √(ln²e + π²) (PHYSICS.md 2.4).
+    pub fn alpha(&self) -> f64 {
+        match *self {
+            Damping::TsujiAlpha(a) => a,
+            Damping::Restitution(e) => alpha_from_restitution(e),
+        }
+    }
+}
+
+/// PHYSICS.md 2.4: α = √5·|ln e| / √(ln²e + π²).
+pub fn alpha_from_restitution(e: f64) -> f64 {
+    let l = e.ln();
+    5f64.sqrt() * l.abs() / (l * l + std::f64::consts::PI.powi(2)).sqrt()
+}
+
+/// PHYSICS.md 2.4: e = exp(−π α / √(5 − α²)).
+pub fn restitution_from_alpha(alpha: f64) -> f64 {
+    (-std::f64::consts::PI * alpha / (5.0 - alpha * alpha).sqrt()).exp()
+}
+
+/// Monodisperse spheres and their contact parameters (paper Table 1).
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Particles {
+    pub diameter_m: f64,
+    pub density_kg_m3: f64,
+    pub youngs_modulus_pa: f64,
+    pub poisson_ratio: f64,
+    pub sliding_friction: f64,
+    pub normal_damping: Damping,
+    pub tangential_damping: Damping,
+}
+
+impl Default for Particles {
+    fn default() -> Self {
+        Particles {
+            diameter_m: 0.0012,
+            density_kg_m3: 1000.0,
+            youngs_modulus_pa: 1.2e8,
+            poisson_ratio: 0.33,
+            sliding_friction: 0.1,
+            normal_damping: Damping::TsujiAlpha(0.02),
+            tangential_damping: Damping::TsujiAlpha(1e-4),
+        }
+    }
+}
+
+/// The initial bed: poured and settled from a seed, or given particle by particle.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Bed {
+    /// Random insertion and settling under gravity. Give exactly one of the two sizes.
+    Generated(GeneratedBed),
+    /// Explicit particle positions (and optional velocities), in metres and m/s.
+    Explicit(ExplicitBed),
+}
+
+impl Default for Bed {
+    fn default() -> Self {
+        Bed::Generated(GeneratedBed::default())
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct GeneratedBed {
+    /// Target settled ("tapped") bed height.
+    #[serde(default)]
+    pub settled_height_m: Option<f64>,
+    /// Or an exact particle count.
+    #[serde(default)]
+    pub count: Option<usize>,
+    /// Seed of the random insertion; the same seed gives the same bed.
+    #[serde(default = "d_seed")]
+    pub seed: u64,
+}
+
+impl Default for GeneratedBed {
+    fn default() -> Self {
+        GeneratedBed { settled_height_m: Some(0.03), count: None, seed: 1 }
+    }
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ExplicitBed {
+    pub positions_m: Vec<[f64; 3]>,
+    #[serde(default)]
+    pub velocities_m_s: Option<Vec<[f64; 3]>>,
+}
+
+/// DEM integration settings.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Dem {
+    /// DEM time step (paper Table 1: 1.25 µs).
+    #[serde(default = "d_dem_dt")]
+    pub time_step_s: f64,
+    /// Verlet skin as a fraction of the particle diameter.
+    #[serde(default = "d_skin")]
+    pub skin_fraction: f64,
+    /// Hold particles fixed after the bed is built (packed-bed runs): no contact work at all.
+    #[serde(default)]
+    pub frozen: bool,
+    /// Worker threads for this run (0 = the pool's default).
+    #[serde(default)]
+    pub threads: usize,
+}
+
+impl Default for Dem {
+    fn default() -> Self {
+        Dem { time_step_s: d_dem_dt(), skin_fraction: d_skin(), frozen: false, threads: 0 }
+    }
+}
+
+/// Fields a snapshot may carry.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, JsonSchema, PartialEq, Eq, Hash)]
+#[serde(rename_all = "snake_case")]
+pub enum Field {
+    Voidage,
+    Pressure,
+    GasVelocity,
+    Particles,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Outputs {
+    /// Simulated time between snapshots.
+    #[serde(default = "d_snapshot_interval")]
+    pub snapshot_interval_s: f64,
+    /// Fields stored in each snapshot.
+    #[serde(default = "d_fields")]
+    pub fields: Vec<Field>,
+    /// Simulated time between checkpoints (0 = at every snapshot).
+    #[serde(default)]
+    pub checkpoint_interval_s: f64,
+}
+
+impl Default for Outputs {
+    fn default() -> Self {
+        Outputs { snapshot_interval_s: d_snapshot_interval(), fields: d_fields(), checkpoint_interval_s: 0.0 }
+    }
+}
+
+/// The gas: isothermal, compressible (PHYSICS.md 8), model-A coupling (PHYSICS.md 11).
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Gas {
+    /// Superficial velocity set at the distributor after the ramp.
+    pub superficial_velocity_m_s: f64,
+    /// Linear ramp of the inlet velocity from zero (paper: 240 ms).
+    #[serde(default = "d_ramp")]
+    pub ramp_time_s: f64,
+    #[serde(default = "d_temperature")]
+    pub temperature_k: f64,
+    /// Specific gas constant R_s; a = √(R_s T) (air: 287.05).
+    #[serde(default = "d_rs")]
+    pub specific_gas_constant_j_kg_k: f64,
+    #[serde(default = "d_mu")]
+    pub viscosity_pa_s: f64,
+    /// Bulk viscosity L (Stokes' hypothesis: 0).
+    #[serde(default)]
+    pub bulk_viscosity_pa_s: f64,
+    /// Absolute pressure at the outlet (initial state and relaxation target).
+    #[serde(default = "d_p_out")]
+    pub outlet_pressure_pa: f64,
+    /// Voidage assigned to the inlet cells below the distributor (paper Table 2: 0.4).
+    #[serde(default = "d_inlet_voidage")]
+    pub inlet_voidage: f64,
+    /// Poinsot-Lele relaxation σ of the outlet toward outlet_pressure_pa (0 = perfectly non-reflecting).
+    #[serde(default = "d_sigma")]
+    pub outlet_relaxation: f64,
+    /// Gas time step; absent = the largest stable step, sub-cycled within the DEM step.
+    #[serde(default)]
+    pub time_step_s: Option<f64>,
+    /// Lower clamp of ε in the drag law (PHYSICS.md 1.1).
+    #[serde(default = "d_eps_min")]
+    pub drag_voidage_min: f64,
+}
+
+impl Default for Gas {
+    fn default() -> Self {
+        Gas {
+            superficial_velocity_m_s: 0.6,
+            ramp_time_s: d_ramp(),
+            temperature_k: d_temperature(),
+            specific_gas_constant_j_kg_k: d_rs(),
+            viscosity_pa_s: d_mu(),
+            bulk_viscosity_pa_s: 0.0,
+            outlet_pressure_pa: d_p_out(),
+            inlet_voidage: d_inlet_voidage(),
+            outlet_relaxation: d_sigma(),
+            time_step_s: None,
+            drag_voidage_min: d_eps_min(),
+        }
+    }
+}
+
+impl Gas {
+    /// Isothermal sound speed a = √(R_s T) (PHYSICS.md 8).
+    pub fn sound_speed_m_s(&self) -> f64 {
+        (self.specific_gas_constant_j_kg_k * self.temperature_k).sqrt()
+    }
+    /// Density at the outlet pressure, ρ = p / a².
+    pub fn outlet_density_kg_m3(&self) -> f64 {
+        self.outlet_pressure_pa / (self.specific_gas_constant_j_kg_k * self.temperature_k)
+    }
+}
+
+/// The equal-volume cylindrical grid: N_r = D/(2 dr) annuli, annulus i holds n0·(2i+1) cells.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Grid {
+    /// Radial spacing; must divide the column radius into whole annuli.
+    pub dr_m: f64,
+    /// Axial spacing; absent = the value nearest dr that divides the column height.
+    #[serde(default)]
+    pub dz_m: Option<f64>,
+    /// Cells in the central annulus (≥ 3). Default 3: the cell's arc length π·dr/n0 ≈ 1.05 dr,
+    /// so cells are as near square as the equal-volume rule allows.
+    #[serde(default = "d_n0")]
+    pub n0: usize,
+}
+
+impl Default for Grid {
+    fn default() -> Self {
+        Grid { dr_m: 0.0044, dz_m: None, n0: d_n0() }
+    }
+}
+
+/// Split of a particle's volume onto boxes in the square-grid method.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BoxSplit {
+    /// Khawaja et al. (2012) cube of side `cube_side_factor`·d (PHYSICS.md 4).
+    Cuboid,
+    /// Exact sphere-box volumes (PHYSICS.md 3).
+    Exact,
+}
+
+/// How particle volume is turned into cell voidage (paper section 1 and 2.3).
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(tag = "method", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Voidage {
+    /// Whole particle volume in the cell of its centre (paper eq. 2).
+    Direct,
+    /// Direct method over the cell and its face neighbours (paper eq. 3).
+    Grouping,
+    /// Box grid mapped onto the cells (paper eq. 8-9).
+    SquareGrid {
+        /// Horizontal box side dl_xy; absent = just above d (configuration 3: 1.375 mm for d = 1.2 mm).
+        #[serde(default)]
+        box_side_m: Option<f64>,
+        #[serde(default = "d_split")]
+        split: BoxSplit,
+        /// Cube side over d for the cuboid split (paper: 1).
+        #[serde(default = "d_one")]
+        cube_side_factor: f64,
+    },
+    /// Exact sphere volume split straight onto the cylindrical cells.
+    ExactCylindrical,
+}
+
+impl Default for Voidage {
+    fn default() -> Self {
+        Voidage::SquareGrid { box_side_m: None, split: BoxSplit::Cuboid, cube_side_factor: 1.0 }
+    }
+}
+
+impl Case {
+    /// Parse JSON (serde errors name the line and column).
+    pub fn from_json(s: &str) -> Result<Case, serde_json::Error> {
+        serde_json::from_str(s)
+    }
+    /// The JSON Schema of a case (published as docs/case.schema.json).
+    pub fn json_schema() -> serde_json::Value {
+        serde_json::to_value(schemars::schema_for!(Case)).expect("schema serialises")
+    }
+    /// Particle volume V_p = π d³ / 6.
+    pub fn particle_volume_m3(&self) -> f64 {
+        std::f64::consts::PI * self.particles.diameter_m.powi(3) / 6.0
+    }
+    /// Particle mass m = ρ_p V_p.
+    pub fn particle_mass_kg(&self) -> f64 {
+        self.particles.density_kg_m3 * self.particle_volume_m3()
+    }
+    /// Axial grid spacing actually used: the given dz, or the height split into layers nearest dr.
+    pub fn grid_dz_m(&self) -> f64 {
+        match self.grid.dz_m {
+            Some(dz) => dz,
+            None => {
+                let n = (self.column.height_m / self.grid.dr_m).round().max(1.0);
+                self.column.height_m / n
+            }
+        }
+    }
+    /// Undamped Hertz contact time between two particles at impact speed v0 (PHYSICS.md 2.4):
+    /// t_c = 2.868 (m*² / (R* E*² v0))^(1/5).
+    pub fn hertz_contact_time_s(&self, v0: f64) -> f64 {
+        let p = &self.particles;
+        let r = p.diameter_m / 2.0;
+        let m_star = self.particle_mass_kg() / 2.0;
+        let r_star = r / 2.0;
+        let e_star = p.youngs_modulus_pa / (2.0 * (1.0 - p.poisson_ratio * p.poisson_ratio));
+        2.868 * (m_star * m_star / (r_star * e_star * e_star * v0)).powf(0.2)
+    }
+}
+
+/// Impact speed used to check the DEM step against the contact time.
+pub const CHECK_IMPACT_SPEED_M_S: f64 = 1.0;
+
+fn d_gravity() -> f64 {
+    9.81
+}
+fn d_end_time() -> f64 {
+    1.0
+}
+fn d_seed() -> u64 {
+    1
+}
+fn d_dem_dt() -> f64 {
+    1.25e-6
+}
+fn d_skin() -> f64 {
+    0.3
+}
+fn d_snapshot_interval() -> f64 {
+    0.01
+}
+fn d_fields() -> Vec<Field> {
+    vec![Field::Voidage, Field::Pressure]
+}
+fn d_ramp() -> f64 {
+    0.24
+}
+fn d_temperature() -> f64 {
+    293.15
+}
+fn d_rs() -> f64 {
+    287.05
+}
+fn d_mu() -> f64 {
+    1.8e-5
+}
+fn d_p_out() -> f64 {
+    101_325.0
+}
+fn d_inlet_voidage() -> f64 {
+    0.4
+}
+fn d_sigma() -> f64 {
+    0.0
+}
+fn d_eps_min() -> f64 {
+    0.1
+}
+fn d_n0() -> usize {
+    3
+}
+fn d_split() -> BoxSplit {
+    BoxSplit::Cuboid
+}
+fn d_one() -> f64 {
+    1.0
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,89 @@
+use super::*;
+
+fn paper_grid() -> CylGrid {
+    // The 44-mm column with dr = 4.4 mm, dz = dr (paper section 3.2).
+    CylGrid::new(0.022, 0.11, 0.0044, 0.0044, 3)
+}
+
+#[test]
+fn every_cell_has_the_same_volume() {
+    for n0 in [3, 4, 6] {
+        let g = CylGrid::new(0.025, 0.1, 0.0025, 0.0025, n0);
+        let v = g.cell_volume();
+        for i in 0..g.nr {
+            let vi = g.cell_volume_from_bounds(i);
+            assert!(((vi - v) / v).abs() < 1e-14, "n0={n0} annulus {i}: {vi} vs {v}");
+        }
+        let total = v * g.num_cells() as f64;
+        let exact = PI * 0.025f64.powi(2) * 0.1;
+        assert!(((total - exact) / exact).abs() < 1e-13);
+    }
+}
+
+#[test]
+fn radial_face_fractions_sum_to_one_on_both_sides() {
+    let g = paper_grid();
+    for i in 0..g.nr {
+        for j in 0..g.cells_in_annulus(i) {
+            if i + 1 < g.nr {
+                let s: f64 = g.outer_neighbours(i, j).iter().map(|l| l.fraction).sum();
+                assert!((s - 1.0).abs() < 1e-15, "outer ({i},{j}) sums to {s}");
+            } else {
+                assert!(g.outer_neighbours(i, j).is_empty());
+            }
+            if i > 0 {
+                let s: f64 = g.inner_neighbours(i, j).iter().map(|l| l.fraction).sum();
+                assert!((s - 1.0).abs() < 1e-15, "inner ({i},{j}) sums to {s}");
+            } else {
+                assert!(g.inner_neighbours(i, j).is_empty());
+            }
+        }
+    }
+}
+
+#[test]
+fn shared_face_areas_agree_from_both_sides() {
+    // Area shared by (i,j) and (i+1,jj), seen from each: r_{i+1}·Δθ_i·frac == r_{i+1}·Δθ_{i+1}·frac'.
+    let g = paper_grid();
+    for i in 0..g.nr - 1 {
+        for j in 0..g.cells_in_annulus(i) {
+            for l in g.outer_neighbours(i, j) {
+                let back = g.inner_neighbours(i + 1, l.j).iter().find(|b| b.j == j).expect("symmetric link");
+                let a = g.dtheta(i) * l.fraction;
+                let b = g.dtheta(i + 1) * back.fraction;
+                assert!((a - b).abs() < 1e-15);
+            }
+        }
+    }
+}
+
+#[test]
+fn locate_finds_the_cell_whose_bounds_hold_the_point() {
+    let g = paper_grid();
+    let mut s = 12345u64;
+    let mut rnd = || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..10_000 {
+        let r = g.radius * rnd().sqrt();
+        let th = 2.0 * PI * rnd();
+        let z = g.height * rnd();
+        let idx = g.locate(r * th.cos(), r * th.sin(), z);
+        let (i, j, k) = g.ijk(idx);
+        assert_eq!(g.index(i, j, k), idx);
+        assert!(r >= i as f64 * g.dr - 1e-12 && r <= (i + 1) as f64 * g.dr + 1e-12);
+        let (t0, t1) = g.theta_bounds(i, j);
+        assert!(th >= t0 - 1e-12 && th <= t1 + 1e-12);
+        assert!(z >= k as f64 * g.dz - 1e-12 && z <= (k + 1) as f64 * g.dz + 1e-12);
+    }
+}
+
+#[test]
+fn ijk_round_trips() {
+    let g = paper_grid();
+    for idx in 0..g.num_cells() {
+        let (i, j, k) = g.ijk(idx);
+        assert_eq!(g.index(i, j, k), idx);
+    }
+}

@@ -1,0 +1,1 @@
+//! Snapshot encoders: JSON, .npy, VTK, PNG.

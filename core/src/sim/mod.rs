@@ -1,0 +1,1 @@
+//! The simulation: state, plan, step loop, watchdog, snapshots and checkpoints.

@@ -1,0 +1,1 @@
+//! fluidbed-server: the HTTP service (see issue 3).
