@@ -1,1 +1,164 @@
-//! fluidbed-server: the HTTP service (see issue 3).
+//! fluidbed-server: the HTTP service. Jobs are stored in SQLite under a data directory, run on
+//! worker threads (each on its own rayon pool) and streamed to clients as server-sent events.
+//!
+//! ```no_run
+//! let cfg = fluidbed_server::Config::new("data".into());
+//! let server = fluidbed_server::Server::start(cfg).unwrap();
+//! println!("listening on http://{}", server.addr());
+//! server.shutdown();
+//! ```
+
+pub mod api;
+pub mod events;
+pub mod job;
+pub mod store;
+pub mod worker;
+
+use anyhow::{Context, Result};
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// How a server is started (the binary's flags).
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub data_dir: PathBuf,
+    /// Address to bind; loopback by default.
+    pub listen: SocketAddr,
+    /// When set, every route but /healthz needs `Authorization: Bearer <token>`.
+    pub token: Option<String>,
+    pub workers: usize,
+    pub threads_per_job: usize,
+    /// Largest accepted request body.
+    pub max_body_bytes: usize,
+    /// Most jobs waiting in the queue; more are answered 429.
+    pub max_queued: usize,
+}
+
+impl Config {
+    pub fn new(data_dir: PathBuf) -> Config {
+        Config {
+            data_dir,
+            listen: SocketAddr::from(([127, 0, 0, 1], 8471)),
+            token: None,
+            workers: 1,
+            threads_per_job: 1,
+            max_body_bytes: 16 << 20,
+            max_queued: 64,
+        }
+    }
+}
+
+/// What handlers and workers share.
+pub struct App {
+    pub config: Config,
+    pub store: store::Store,
+    pub hub: events::Hub,
+    pub queue: worker::Queue,
+    pub cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
+    stopping: AtomicBool,
+}
+
+impl App {
+    /// Set when the server stops: workers then write nothing more and leave running jobs to be
+    /// resumed from their checkpoint by the next server on this data directory.
+    pub fn stopping(&self) -> bool {
+        self.stopping.load(Ordering::SeqCst)
+    }
+}
+
+/// A running server.
+pub struct Server {
+    addr: SocketAddr,
+    app: Arc<App>,
+    runtime: Option<tokio::runtime::Runtime>,
+    shutdown_tx: Option<tokio::sync::oneshot::Sender<()>>,
+    workers: Vec<std::thread::JoinHandle<()>>,
+}
+
+impl Server {
+    /// Open the store, resume unfinished jobs, start the workers and the HTTP listener.
+    pub fn start(config: Config) -> Result<Server> {
+        let store = store::Store::open(&config.data_dir)?;
+        let app = Arc::new(App {
+            store,
+            hub: events::Hub::default(),
+            queue: worker::Queue::default(),
+            cancels: Mutex::new(HashMap::new()),
+            stopping: AtomicBool::new(false),
+            config,
+        });
+        // Jobs that were running resume from their last checkpoint; queued ones queue again.
+        for status in [job::Status::Running, job::Status::Queued] {
+            for id in app.store.ids_with(status)? {
+                app.queue.push(id);
+            }
+        }
+        let listener = std::net::TcpListener::bind(app.config.listen).with_context(|| format!("bind {}", app.config.listen))?;
+        listener.set_nonblocking(true)?;
+        let addr = listener.local_addr()?;
+        let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).thread_name("fluidbed-http").enable_all().build()?;
+        let (shutdown_tx, shutdown_rx) = tokio::sync::oneshot::channel::<()>();
+        let router = api::router(app.clone());
+        runtime.spawn(async move {
+            let listener = tokio::net::TcpListener::from_std(listener).expect("listener");
+            let _ = axum::serve(listener, router)
+                .with_graceful_shutdown(async {
+                    let _ = shutdown_rx.await;
+                })
+                .await;
+        });
+        let workers = worker::spawn(&app, app.config.workers);
+        Ok(Server { addr, app, runtime: Some(runtime), shutdown_tx: Some(shutdown_tx), workers })
+    }
+
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+    pub fn url(&self) -> String {
+        format!("http://{}", self.addr)
+    }
+
+    /// Stop: no new requests, workers stop between chunks; running jobs stay `running` in the
+    /// store and resume from their checkpoints on the next start.
+    pub fn shutdown(mut self) {
+        if let Some(tx) = self.shutdown_tx.take() {
+            let _ = tx.send(());
+        }
+        self.stop(Duration::from_secs(30));
+    }
+
+    /// Drop the server as a crash would: the HTTP runtime is torn down at once and the workers
+    /// abandon their jobs mid-run without writing anything more.
+    pub fn kill(mut self) {
+        self.stop(Duration::from_secs(5));
+    }
+
+    fn stop(&mut self, wait: Duration) {
+        self.app.stopping.store(true, Ordering::SeqCst);
+        self.app.queue.wake_all();
+        if let Some(rt) = self.runtime.take() {
+            rt.shutdown_background();
+        }
+        let t0 = Instant::now();
+        for w in self.workers.drain(..) {
+            while !w.is_finished() && t0.elapsed() < wait {
+                std::thread::sleep(Duration::from_millis(10));
+            }
+            if w.is_finished() {
+                let _ = w.join();
+            }
+        }
+    }
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        if self.runtime.is_some() {
+            self.stop(Duration::from_secs(5));
+        }
+    }
+}

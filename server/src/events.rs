@@ -1,0 +1,137 @@
+//! Server-sent events of a job: `status`, `progress`, `snapshot` (id = snapshot number) and a
+//! final `end` event, after which the stream closes. A client connecting late, or resuming with
+//! `Last-Event-ID: n`, first gets the stored snapshots after n, then the live events.
+
+use crate::job::SnapshotInfo;
+use crate::App;
+use axum::response::sse::Event;
+use fluidbed_core::output::fields;
+use fluidbed_core::sim::snapshot::Snapshot;
+use serde_json::{json, Value};
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex};
+use tokio::sync::{broadcast, mpsc};
+
+/// One event as broadcast to live listeners.
+#[derive(Clone, Debug)]
+pub struct JobEvent {
+    pub kind: &'static str,
+    /// The snapshot number of a `snapshot` event.
+    pub n: Option<u64>,
+    pub data: Arc<String>,
+}
+
+impl JobEvent {
+    pub fn new(kind: &'static str, n: Option<u64>, data: &Value) -> JobEvent {
+        JobEvent { kind, n, data: Arc::new(data.to_string()) }
+    }
+    fn sse(&self) -> Event {
+        let e = Event::default().event(self.kind).data(self.data.as_str());
+        match self.n {
+            Some(n) => e.id(n.to_string()),
+            None => e,
+        }
+    }
+}
+
+/// Per-job broadcast channels.
+#[derive(Default)]
+pub struct Hub {
+    channels: Mutex<HashMap<String, broadcast::Sender<JobEvent>>>,
+}
+
+impl Hub {
+    fn sender(&self, id: &str) -> broadcast::Sender<JobEvent> {
+        let mut m = self.channels.lock().unwrap_or_else(|e| e.into_inner());
+        m.entry(id.to_string()).or_insert_with(|| broadcast::channel(256).0).clone()
+    }
+    pub fn publish(&self, id: &str, ev: JobEvent) {
+        let _ = self.sender(id).send(ev);
+    }
+    pub fn subscribe(&self, id: &str) -> broadcast::Receiver<JobEvent> {
+        self.sender(id).subscribe()
+    }
+    /// Forget a finished job's channel (listeners already hold their receivers).
+    pub fn close(&self, id: &str) {
+        self.channels.lock().unwrap_or_else(|e| e.into_inner()).remove(id);
+    }
+}
+
+/// The `snapshot` event's payload: cell voidage and pressure, total and per-layer ΔP.
+pub fn snapshot_payload(s: &Snapshot, info: &SnapshotInfo) -> Value {
+    json!({
+        "n": s.index,
+        "time_s": s.time_s,
+        "step": s.step,
+        "cells_per_layer": s.grid.grid().cells_per_layer(),
+        "nz": s.grid.nz,
+        "voidage": fields::voidage(s),
+        "pressure_pa": s.pressure_pa,
+        "pressure_drop_pa": s.pressure_drop_pa,
+        "layer_pressure_drop_pa": s.layer_pressure_drop_pa,
+        "mean_particle_height_m": info.mean_particle_height_m,
+    })
+}
+
+/// Feed one listener: replay what it missed from the store, then follow the live channel.
+pub async fn pump(app: Arc<App>, id: String, last_seen: Option<u64>, tx: mpsc::Sender<Event>) {
+    let mut live = app.hub.subscribe(&id);
+    let mut next = last_seen.map_or(0, |n| n + 1);
+    let Ok(Some(job)) = app.store.get(&id) else { return };
+    if tx.send(JobEvent::new("status", None, &job.status_json()).sse()).await.is_err() {
+        return;
+    }
+    if !replay(&app, &id, &mut next, &tx).await {
+        return;
+    }
+    let Ok(Some(job)) = app.store.get(&id) else { return };
+    if tx.send(JobEvent::new("progress", None, &job.progress_json()).sse()).await.is_err() {
+        return;
+    }
+    if job.status.is_final() {
+        let _ = replay(&app, &id, &mut next, &tx).await;
+        let _ = tx.send(JobEvent::new("end", None, &job.status_json()).sse()).await;
+        return;
+    }
+    loop {
+        match live.recv().await {
+            Ok(ev) => {
+                if let Some(n) = ev.n {
+                    if n < next {
+                        continue;
+                    }
+                    next = n + 1;
+                }
+                let end = ev.kind == "end";
+                if tx.send(ev.sse()).await.is_err() || end {
+                    return;
+                }
+            }
+            Err(broadcast::error::RecvError::Lagged(_)) => {
+                if !replay(&app, &id, &mut next, &tx).await {
+                    return;
+                }
+            }
+            Err(broadcast::error::RecvError::Closed) => return,
+        }
+    }
+}
+
+/// Send stored snapshots numbered `next` and up; false when the listener has gone.
+async fn replay(app: &Arc<App>, id: &str, next: &mut u64, tx: &mpsc::Sender<Event>) -> bool {
+    let Ok(list) = app.store.snapshots(id) else { return true };
+    let from = *next;
+    for info in list.into_iter().filter(|i| i.n >= from) {
+        let (a, job) = (app.clone(), id.to_string());
+        let n = info.n;
+        let loaded = tokio::task::spawn_blocking(move || a.store.snapshot(&job, n)).await;
+        if let Ok(Ok(Some(s))) = loaded {
+            let ev = JobEvent::new("snapshot", Some(n), &snapshot_payload(&s, &info));
+            if tx.send(ev.sse()).await.is_err() {
+                return false;
+            }
+            *next = n + 1;
+        }
+    }
+    true
+}

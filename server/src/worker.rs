@@ -1,0 +1,194 @@
+//! Worker threads: each takes a job from the queue and runs it on its own rayon pool, never on
+//! the async runtime. Between chunks of steps it checks for cancellation, stores snapshots,
+//! writes checkpoints atomically, and publishes progress.
+
+use crate::events::{snapshot_payload, JobEvent};
+use crate::job::{now_rfc3339, SnapshotInfo, Status};
+use crate::App;
+use anyhow::Result;
+use fluidbed_core::case::Case;
+use fluidbed_core::output::fields;
+use fluidbed_core::sim::Simulation;
+use std::collections::VecDeque;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Condvar, Mutex};
+use std::time::{Duration, Instant};
+
+/// Wall time one chunk of steps aims at: short enough for prompt cancels and smooth progress.
+const CHUNK_WALL: Duration = Duration::from_millis(150);
+/// Least wall time between two progress events.
+const PROGRESS_EVERY: Duration = Duration::from_millis(300);
+
+/// The FIFO of job ids waiting for a worker.
+#[derive(Default)]
+pub struct Queue {
+    ids: Mutex<VecDeque<String>>,
+    ready: Condvar,
+}
+
+impl Queue {
+    pub fn push(&self, id: String) {
+        self.ids.lock().unwrap_or_else(|e| e.into_inner()).push_back(id);
+        self.ready.notify_one();
+    }
+    /// The next id, or None after `timeout` (so workers can notice a shutdown).
+    fn pop(&self, timeout: Duration) -> Option<String> {
+        let mut q = self.ids.lock().unwrap_or_else(|e| e.into_inner());
+        if q.is_empty() {
+            q = self.ready.wait_timeout(q, timeout).unwrap_or_else(|e| e.into_inner()).0;
+        }
+        q.pop_front()
+    }
+    pub fn wake_all(&self) {
+        self.ready.notify_all();
+    }
+}
+
+/// Start `n` worker threads.
+pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
+    (0..n.max(1))
+        .map(|k| {
+            let app = app.clone();
+            std::thread::Builder::new()
+                .name(format!("fluidbed-worker-{k}"))
+                .spawn(move || {
+                    while !app.stopping() {
+                        if let Some(id) = app.queue.pop(Duration::from_millis(200)) {
+                            if let Err(e) = run_job(&app, &id) {
+                                if !app.stopping() {
+                                    eprintln!("fluidbed-server: job {id}: {e:#}");
+                                    let msg = format!("internal error: {e:#}");
+                                    finish(&app, &id, Status::Failed, Some(&msg));
+                                }
+                            }
+                        }
+                    }
+                })
+                .expect("spawn worker thread")
+        })
+        .collect()
+}
+
+fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
+    if app.stopping() {
+        return;
+    }
+    if let Ok(true) = app.store.finish(id, status, message, &now_rfc3339()) {
+        if let Ok(Some(job)) = app.store.get(id) {
+            app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+            app.hub.publish(id, JobEvent::new("end", None, &job.status_json()));
+        }
+    }
+    app.cancels.lock().unwrap_or_else(|e| e.into_inner()).remove(id);
+    app.hub.close(id);
+}
+
+/// The cancel flag of a job (created on first use).
+pub fn cancel_flag(app: &App, id: &str) -> Arc<AtomicBool> {
+    app.cancels.lock().unwrap_or_else(|e| e.into_inner()).entry(id.to_string()).or_default().clone()
+}
+
+fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
+    let Some(job) = app.store.get(id)? else { return Ok(()) };
+    if job.status.is_final() {
+        return Ok(());
+    }
+    let cancel = cancel_flag(app, id);
+    if cancel.load(Ordering::SeqCst) {
+        finish(app, id, Status::Cancelled, Some("cancelled before it started"));
+        return Ok(());
+    }
+    app.store.set_running(id, &now_rfc3339())?;
+    if let Some(job) = app.store.get(id)? {
+        app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+    }
+    let threads = app.config.threads_per_job.max(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
+    let base_wall = job.wall_s;
+    pool.install(|| drive(app, id, &cancel, base_wall))
+}
+
+/// Build or restore the simulation and step it to the end, a chunk at a time.
+fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Result<()> {
+    let started = Instant::now();
+    let mut sim = match app.store.checkpoint(id)? {
+        Some(bytes) => match Simulation::restore(&bytes) {
+            Ok(s) => s,
+            Err(e) => return fail(app, id, &e.to_string()),
+        },
+        None => {
+            let case_json = app.store.case_json(id)?.unwrap_or_default();
+            let case: Case = serde_json::from_str(&case_json)?;
+            match Simulation::new(case, Some(&app.store.cache_dir())) {
+                Ok(s) => s,
+                Err(e) => return fail(app, id, &e.to_string()),
+            }
+        }
+    };
+    if app.stopping() {
+        return Ok(());
+    }
+    app.store.set_plan(id, &serde_json::to_value(sim.plan())?)?;
+    let checkpoint_every = sim.case().outputs.checkpoint_interval_s;
+    let mut last_checkpoint_t = sim.time();
+    let (t_start, end) = (sim.time(), sim.end_time());
+    let mut chunk: u64 = 10;
+    let mut last_progress = Instant::now() - PROGRESS_EVERY;
+    while !sim.is_finished() {
+        if app.stopping() {
+            return Ok(());
+        }
+        if cancel.load(Ordering::SeqCst) {
+            finish(app, id, Status::Cancelled, Some("cancelled by request"));
+            return Ok(());
+        }
+        let t0 = Instant::now();
+        let out = sim.advance(chunk);
+        // Aim each chunk at CHUNK_WALL, growing or shrinking by at most 2x.
+        let took = t0.elapsed().as_secs_f64().max(1e-6);
+        chunk = ((chunk as f64 * (CHUNK_WALL.as_secs_f64() / took).clamp(0.5, 2.0)) as u64).clamp(1, 1 << 24);
+        let snap = match out {
+            Ok(s) => s,
+            Err(e) => return fail(app, id, &e.to_string()),
+        };
+        if app.stopping() {
+            return Ok(());
+        }
+        let wall = base_wall + started.elapsed().as_secs_f64();
+        let rate = (sim.time() - t_start) / started.elapsed().as_secs_f64().max(1e-9);
+        let eta = (rate > 0.0).then(|| (end - sim.time()).max(0.0) / rate);
+        if let Some(s) = snap {
+            let info = SnapshotInfo {
+                n: s.index,
+                time_s: s.time_s,
+                step: s.step,
+                pressure_drop_pa: s.pressure_drop_pa,
+                mean_particle_height_m: fields::mean_particle_height_m(&s),
+            };
+            app.store.put_snapshot(id, &s, &info)?;
+            if sim.time() - last_checkpoint_t >= checkpoint_every || sim.is_finished() {
+                if app.stopping() {
+                    return Ok(());
+                }
+                app.store.put_checkpoint(id, &sim.checkpoint())?;
+                last_checkpoint_t = sim.time();
+            }
+            app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
+            app.hub.publish(id, JobEvent::new("snapshot", Some(s.index), &snapshot_payload(&s, &info)));
+        }
+        if last_progress.elapsed() >= PROGRESS_EVERY || sim.is_finished() {
+            last_progress = Instant::now();
+            app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
+            if let Some(job) = app.store.get(id)? {
+                app.hub.publish(id, JobEvent::new("progress", None, &job.progress_json()));
+            }
+        }
+    }
+    finish(app, id, Status::Succeeded, None);
+    Ok(())
+}
+
+fn fail(app: &Arc<App>, id: &str, message: &str) -> Result<()> {
+    finish(app, id, Status::Failed, Some(message));
+    Ok(())
+}
