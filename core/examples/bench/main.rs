@@ -1,9 +1,12 @@
 //! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|all>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
+mod dem;
+
 fn main() {
     let what = std::env::args().nth(1).unwrap_or_else(|| "all".into());
     match what.as_str() {
+        "dem" => dem::run(),
         other => {
             eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage or all");
             std::process::exit(2);

@@ -1,1 +1,75 @@
 //! Soft-sphere DEM: Hertz + Tsuji contacts, tube wall, AB3 (paper section 2.1).
+//!
+//! - `contact`: the contact law (PHYSICS.md 2), one kernel for pairs and walls;
+//! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
+//! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
+//! - `forces`: the two deterministic parallel passes of a step;
+//! - `system`: `DemSystem`, the state and the step loop;
+//! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
+
+pub mod bed;
+pub mod contact;
+pub mod forces;
+pub mod integrator;
+pub mod neighbors;
+pub mod system;
+
+#[cfg(test)]
+mod tests;
+
+pub use bed::build_bed;
+pub use system::DemSystem;
+
+use crate::case::Case;
+use contact::ContactLaw;
+use serde::{Deserialize, Serialize};
+
+/// Everything a step needs that does not change during a run (from the case).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct DemParams {
+    pub radius: f64,
+    pub mass: f64,
+    /// Moment of inertia of a solid sphere, 2/5 m R².
+    pub inertia: f64,
+    pub dt: f64,
+    /// Magnitude of gravity along −z.
+    pub gravity: f64,
+    pub tube_radius: f64,
+    pub height: f64,
+    pub lid: bool,
+    /// Verlet skin (absolute) and list cutoff d + skin.
+    pub skin: f64,
+    pub cutoff: f64,
+    /// Particle-particle law: R* = R/2, m* = m/2.
+    pub pair: ContactLaw,
+    /// Particle-wall law: R* = R, m* = m, the wall of the particles' material.
+    pub wall: ContactLaw,
+    /// μ > 0: tangential history and rotation are integrated (else skipped, same result).
+    pub friction: bool,
+    /// Extra viscous damping rate (1/s) on v and ω; used only while pouring a bed, 0 otherwise.
+    pub extra_damping: f64,
+}
+
+impl DemParams {
+    pub fn new(case: &Case) -> Self {
+        let r = case.particles.diameter_m / 2.0;
+        let m = case.particle_mass_kg();
+        let skin = case.dem.skin_fraction * case.particles.diameter_m;
+        DemParams {
+            radius: r,
+            mass: m,
+            inertia: 0.4 * m * r * r,
+            dt: case.dem.time_step_s,
+            gravity: case.gravity_m_s2,
+            tube_radius: case.column.diameter_m / 2.0,
+            height: case.column.height_m,
+            lid: case.column.lid,
+            skin,
+            cutoff: 2.0 * r + skin,
+            pair: ContactLaw::new(case, r / 2.0, m / 2.0),
+            wall: ContactLaw::new(case, r, m),
+            friction: case.particles.sliding_friction > 0.0,
+            extra_damping: 0.0,
+        }
+    }
+}

@@ -1,0 +1,101 @@
+//! DEM throughput on the settled 44-mm bed (~25,000 particles, LIGGGHTS anchor settings):
+//! 1,000 warm-up steps, then 2,000 timed steps, once on 1 thread and once on all cores.
+//! Prints `{"bench":"dem","particles":…,"steps":…,"threads":…,"particle_steps_per_s":…}` per run.
+
+use fluidbed_core::case::{Bed, Case, Damping, ExplicitBed, GeneratedBed};
+use fluidbed_core::dem::{build_bed, DemSystem};
+use std::time::Instant;
+
+const ANCHOR: &str = "../shared/anchors/settled_25000.data.gz";
+
+/// The anchor scene: paper Table 1 particles with e = 0.9 for normal and tangential damping.
+fn bench_case() -> Case {
+    let mut c: Case = serde_json::from_str(
+        r#"{"column":{"diameter_m":0.044,"height_m":0.06},"particles":{},"bed":{"generated":{"count":25000,"seed":1}}}"#,
+    )
+    .expect("bench case");
+    c.particles.diameter_m = 0.0012;
+    c.particles.density_kg_m3 = 1000.0;
+    c.particles.youngs_modulus_pa = 1.2e8;
+    c.particles.poisson_ratio = 0.33;
+    c.particles.sliding_friction = 0.1;
+    c.particles.normal_damping = Damping::Restitution(0.9);
+    c.particles.tangential_damping = Damping::Restitution(0.9);
+    c.dem.time_step_s = 1.25e-6;
+    c.dem.skin_fraction = 0.3;
+    c.gravity_m_s2 = 9.81;
+    c
+}
+
+/// Positions from the LAMMPS data file (columns id type diameter density x y z), in id order.
+fn load_anchor() -> Option<Vec<[f64; 3]>> {
+    let candidates = [ANCHOR.to_string(), format!("{}/../../shared/anchors/settled_25000.data.gz", env!("CARGO_MANIFEST_DIR"))];
+    let path = candidates.iter().find(|p| std::path::Path::new(p).exists())?;
+    let out = std::process::Command::new("zcat").arg(path).output().ok()?;
+    let text = String::from_utf8(out.stdout).ok()?;
+    let mut rows: Vec<(u64, [f64; 3])> = Vec::new();
+    let mut in_atoms = false;
+    for line in text.lines() {
+        let t = line.trim();
+        if t.starts_with("Atoms") {
+            in_atoms = true;
+            continue;
+        }
+        if !in_atoms || t.is_empty() {
+            continue;
+        }
+        let f: Vec<&str> = t.split_whitespace().collect();
+        if f.len() < 7 {
+            if !rows.is_empty() {
+                break;
+            }
+            continue;
+        }
+        let num = |k: usize| f[k].parse::<f64>().ok();
+        rows.push((f[0].parse().ok()?, [num(4)?, num(5)?, num(6)?]));
+    }
+    rows.sort_by_key(|r| r.0);
+    Some(rows.into_iter().map(|r| r.1).collect())
+}
+
+pub fn run() {
+    let mut case = bench_case();
+    let positions = match load_anchor() {
+        Some(p) => p,
+        None => {
+            eprintln!("{ANCHOR} not found: pouring the bed with build_bed (slow)");
+            case.bed = Bed::Generated(GeneratedBed { settled_height_m: None, count: Some(25000), seed: 1 });
+            build_bed(&case, Some(std::path::Path::new("target/bed-cache"))).expect("bed").0
+        }
+    };
+    case.bed = Bed::Explicit(ExplicitBed { positions_m: positions.clone(), velocities_m_s: None });
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let mut counts = vec![1];
+    if cores > 1 {
+        counts.push(cores);
+    }
+    let (warm, timed) = (1000u64, 2000u64);
+    for threads in counts {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+        pool.install(|| {
+            let mut sys = DemSystem::new(&case, positions.clone(), vec![[0.0; 3]; positions.len()]);
+            for _ in 0..warm {
+                sys.step();
+            }
+            let t0 = Instant::now();
+            for _ in 0..timed {
+                sys.step();
+            }
+            let secs = t0.elapsed().as_secs_f64();
+            let rate = sys.len() as f64 * timed as f64 / secs;
+            eprintln!("dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d", secs, sys.kinetic_energy(), sys.max_overlap_fraction());
+            println!(
+                "{{\"bench\":\"dem\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",
+                sys.len(),
+                timed,
+                threads,
+                rate
+            );
+        });
+    }
+}

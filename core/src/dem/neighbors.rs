@@ -1,0 +1,226 @@
+//! O(N) neighbour search: linked cells give the cell order (particles are re-sorted by cell
+//! at every rebuild for memory locality) and a half Verlet list (each pair once, j > i) in CSR
+//! form with the tangential contact history stored parallel to it. History survives rebuilds
+//! by particle-id pair. Everything here is deterministic and independent of the thread count.
+
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Particles per work block in the parallel passes (fixed, so results do not depend on threads).
+pub const BLOCK: usize = 256;
+
+/// Half neighbour list in CSR form, plus its transpose (pairs where a particle is the second).
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct NeighborList {
+    /// Row i is nbr[offsets[i]..offsets[i+1]], all j > i.
+    pub offsets: Vec<u32>,
+    pub nbr: Vec<u32>,
+    /// Tangential displacement ξ of each listed pair (oriented i → j), zero when not touching.
+    pub shear: Vec<[f64; 3]>,
+    /// Transpose: pair indices k with nbr[k] == j are rev_pairs[rev_offsets[j]..rev_offsets[j+1]].
+    #[serde(skip)]
+    pub rev_offsets: Vec<u32>,
+    #[serde(skip)]
+    pub rev_pairs: Vec<u32>,
+}
+
+/// Cell order of the particles: the permutation that sorts them by linked cell (stable).
+pub fn cell_order(x: &[[f64; 3]], tube_radius: f64, cell: f64) -> Vec<u32> {
+    let grid = CellGrid::new(x, tube_radius, cell);
+    let cells: Vec<u32> = x.iter().map(|p| grid.cell_of(p) as u32).collect();
+    let mut count = vec![0u32; grid.len() + 1];
+    for &c in &cells {
+        count[c as usize + 1] += 1;
+    }
+    for c in 0..grid.len() {
+        count[c + 1] += count[c];
+    }
+    let mut order = vec![0u32; x.len()];
+    for (i, &c) in cells.iter().enumerate() {
+        order[count[c as usize] as usize] = i as u32;
+        count[c as usize] += 1;
+    }
+    order
+}
+
+/// Uniform cells of side ≥ `cell` covering the tube cross-section and the particles' z range.
+struct CellGrid {
+    lo: [f64; 3],
+    inv: [f64; 3],
+    n: [usize; 3],
+}
+
+impl CellGrid {
+    fn new(x: &[[f64; 3]], tube_radius: f64, cell: f64) -> Self {
+        let (mut zlo, mut zhi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for p in x {
+            zlo = zlo.min(p[2]);
+            zhi = zhi.max(p[2]);
+        }
+        if !(zlo.is_finite() && zhi.is_finite()) {
+            (zlo, zhi) = (0.0, 0.0);
+        }
+        let side = 2.0 * tube_radius;
+        let nxy = ((side / cell).floor() as usize).max(1);
+        let nz = (((zhi - zlo) / cell).floor() as usize).clamp(1, 1 << 20);
+        let dxy = side / nxy as f64;
+        let dz = ((zhi - zlo) / nz as f64).max(cell);
+        CellGrid { lo: [-tube_radius, -tube_radius, zlo], inv: [1.0 / dxy, 1.0 / dxy, 1.0 / dz], n: [nxy, nxy, nz] }
+    }
+    fn len(&self) -> usize {
+        self.n[0] * self.n[1] * self.n[2]
+    }
+    #[inline]
+    fn coord(&self, p: &[f64; 3], a: usize) -> usize {
+        let c = ((p[a] - self.lo[a]) * self.inv[a]).floor();
+        (c.max(0.0) as usize).min(self.n[a] - 1)
+    }
+    #[inline]
+    fn cell_of(&self, p: &[f64; 3]) -> usize {
+        (self.coord(p, 2) * self.n[1] + self.coord(p, 1)) * self.n[0] + self.coord(p, 0)
+    }
+}
+
+/// Build the half list for particles already sorted by cell (`x` in cell order), pairs closer
+/// than `cutoff`. Row j-indices come out ascending.
+pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList {
+    let grid = CellGrid::new(x, tube_radius, cutoff);
+    let ncell = grid.len();
+    let cells: Vec<usize> = x.iter().map(|p| grid.cell_of(p)).collect();
+    let mut start = vec![0u32; ncell + 1];
+    for &c in &cells {
+        start[c + 1] += 1;
+    }
+    for c in 0..ncell {
+        start[c + 1] += start[c];
+    }
+    let c2 = cutoff * cutoff;
+    let [nx, ny, nz] = grid.n;
+    // Rows built per block in parallel, concatenated in block order.
+    let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(BLOCK))
+        .into_par_iter()
+        .map(|b| {
+            let (a, e) = (b * BLOCK, ((b + 1) * BLOCK).min(x.len()));
+            let mut counts = Vec::with_capacity(e - a);
+            let mut list = Vec::with_capacity((e - a) * 8);
+            for i in a..e {
+                let before = list.len();
+                let c = cells[i];
+                let (ix, iy, iz) = (c % nx, (c / nx) % ny, c / (nx * ny));
+                let xi = x[i];
+                // Neighbour cells in increasing linear index: j ascending, and j > i.
+                for dz in 0..3usize {
+                    let z = iz + dz;
+                    if z == 0 || z > nz {
+                        continue;
+                    }
+                    for dy in 0..3usize {
+                        let y = iy + dy;
+                        if y == 0 || y > ny {
+                            continue;
+                        }
+                        for dxx in 0..3usize {
+                            let xx = ix + dxx;
+                            if xx == 0 || xx > nx {
+                                continue;
+                            }
+                            let cc = ((z - 1) * ny + (y - 1)) * nx + (xx - 1);
+                            if cc < c {
+                                continue;
+                            }
+                            let lo = (start[cc] as usize).max(i + 1);
+                            for j in lo..start[cc + 1] as usize {
+                                let d = [x[j][0] - xi[0], x[j][1] - xi[1], x[j][2] - xi[2]];
+                                if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < c2 {
+                                    list.push(j as u32);
+                                }
+                            }
+                        }
+                    }
+                }
+                counts.push((list.len() - before) as u32);
+            }
+            (counts, list)
+        })
+        .collect();
+    let mut offsets = Vec::with_capacity(x.len() + 1);
+    offsets.push(0u32);
+    let total: usize = rows.iter().map(|r| r.1.len()).sum();
+    let mut nbr = Vec::with_capacity(total);
+    for (counts, list) in rows {
+        for c in counts {
+            offsets.push(offsets.last().unwrap() + c);
+        }
+        nbr.extend_from_slice(&list);
+    }
+    let mut nl = NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], ..Default::default() };
+    nl.build_reverse(x.len());
+    nl
+}
+
+impl NeighborList {
+    /// Transpose of the list (serial, so the order of pairs per particle is fixed).
+    pub fn build_reverse(&mut self, n: usize) {
+        let mut ro = vec![0u32; n + 1];
+        for &j in &self.nbr {
+            ro[j as usize + 1] += 1;
+        }
+        for j in 0..n {
+            ro[j + 1] += ro[j];
+        }
+        let mut fill = ro.clone();
+        let mut rp = vec![0u32; self.nbr.len()];
+        for (k, &j) in self.nbr.iter().enumerate() {
+            rp[fill[j as usize] as usize] = k as u32;
+            fill[j as usize] += 1;
+        }
+        self.rev_offsets = ro;
+        self.rev_pairs = rp;
+    }
+
+    /// Carry the non-zero contact history of `old` (whose particles had ids `old_ids`) into this
+    /// list (particles with ids `new_ids`), matched by id pair; orientation flips change the sign.
+    pub fn carry_history(&mut self, old: &NeighborList, old_ids: &[u32], new_ids: &[u32]) {
+        let n = new_ids.len();
+        if old.offsets.len() != old_ids.len() + 1 {
+            return; // no previous list (first build)
+        }
+        // Map keyed by the smaller id: CSR over ids of (larger id, ξ oriented small → large).
+        let mut count = vec![0u32; n + 1];
+        let mut entries = Vec::new();
+        for i in 0..old_ids.len() {
+            for k in old.offsets[i] as usize..old.offsets[i + 1] as usize {
+                let s = old.shear[k];
+                if s == [0.0; 3] {
+                    continue;
+                }
+                let (a, b) = (old_ids[i], old_ids[old.nbr[k] as usize]);
+                let (lo, hi, s) = if a < b { (a, b, s) } else { (b, a, [-s[0], -s[1], -s[2]]) };
+                count[lo as usize + 1] += 1;
+                entries.push((lo, hi, s));
+            }
+        }
+        if entries.is_empty() {
+            return;
+        }
+        for i in 0..n {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut map = vec![(0u32, [0.0; 3]); entries.len()];
+        for (lo, hi, s) in entries {
+            map[fill[lo as usize] as usize] = (hi, s);
+            fill[lo as usize] += 1;
+        }
+        for i in 0..n {
+            for k in self.offsets[i] as usize..self.offsets[i + 1] as usize {
+                let (a, b) = (new_ids[i], new_ids[self.nbr[k] as usize]);
+                let (lo, hi, sign) = if a < b { (a, b, 1.0) } else { (b, a, -1.0) };
+                let row = &map[count[lo as usize] as usize..count[lo as usize + 1] as usize];
+                if let Some(&(_, s)) = row.iter().find(|e| e.0 == hi) {
+                    self.shear[k] = [sign * s[0], sign * s[1], sign * s[2]];
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,262 @@
+//! `DemSystem`: the particle state (structure of arrays) and the step loop.
+//! A step is: pair pass → fused particle pass (walls, gravity, external force, AB update) →
+//! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
+
+use super::contact::V3;
+use super::forces::{accel_pass, pair_pass, update_pass, Past, Stats};
+use super::integrator::weights;
+use super::neighbors::{build_list, cell_order, NeighborList};
+use super::DemParams;
+use crate::case::Case;
+use serde::{Deserialize, Serialize};
+
+/// The complete DEM state; serde gives checkpoints with bit-identical continuation.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct DemSystem {
+    pub(super) p: DemParams,
+    pub(super) x: Vec<V3>,
+    pub(super) v: Vec<V3>,
+    pub(super) w: Vec<V3>,
+    pub(super) past: Vec<Past>,
+    pub(super) ext: Vec<V3>,
+    pub(super) ids: Vec<u32>,
+    pub(super) nl: NeighborList,
+    /// Derivative levels held for the multistep scheme: 0 → Heun next, 2 → AB2, 3 → AB3.
+    levels: u8,
+    steps: u64,
+    time: f64,
+    frozen: bool,
+    rebuild_due: bool,
+    last: (f64, f64),
+    /// Scratch per-pair arrays (force on the first particle, n × F_t), rebuilt every step.
+    #[serde(skip)]
+    pf: Vec<V3>,
+    #[serde(skip)]
+    pc: Vec<V3>,
+}
+
+impl DemSystem {
+    /// Particles at `positions` with `velocities` (zero spin), case parameters; order is re-sorted.
+    pub fn new(case: &Case, positions: Vec<[f64; 3]>, velocities: Vec<[f64; 3]>) -> Self {
+        Self::with_params(DemParams::new(case), positions, velocities)
+    }
+
+    pub(super) fn with_params(p: DemParams, positions: Vec<V3>, velocities: Vec<V3>) -> Self {
+        let n = positions.len();
+        assert_eq!(velocities.len(), n, "one velocity per particle");
+        let mut s = DemSystem {
+            p,
+            x: positions,
+            v: velocities,
+            w: vec![[0.0; 3]; n],
+            past: vec![Past::default(); n],
+            ext: vec![[0.0; 3]; n],
+            ids: (0..n as u32).collect(),
+            nl: NeighborList::default(),
+            levels: 0,
+            steps: 0,
+            time: 0.0,
+            frozen: false,
+            rebuild_due: false,
+            last: (0.0, f64::NEG_INFINITY),
+            pf: Vec::new(),
+            pc: Vec::new(),
+        };
+        s.rebuild();
+        s
+    }
+
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+    /// Per-particle extra force (drag, −V∇p) in the current order, held through the next step.
+    pub fn external_forces_mut(&mut self) -> &mut [[f64; 3]] {
+        &mut self.ext
+    }
+    pub fn positions(&self) -> &[[f64; 3]] {
+        &self.x
+    }
+    pub fn velocities(&self) -> &[[f64; 3]] {
+        &self.v
+    }
+    pub fn angular_velocities(&self) -> &[[f64; 3]] {
+        &self.w
+    }
+    /// Original index of each particle in the current order.
+    pub fn ids(&self) -> &[u32] {
+        &self.ids
+    }
+    pub fn radius(&self) -> f64 {
+        self.p.radius
+    }
+    pub fn params(&self) -> &DemParams {
+        &self.p
+    }
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+    pub fn is_frozen(&self) -> bool {
+        self.frozen
+    }
+    /// Frozen: `step` only advances time. Unfreezing restarts the multistep scheme (Heun first).
+    pub fn set_frozen(&mut self, frozen: bool) {
+        if self.frozen && !frozen {
+            self.levels = 0;
+        }
+        self.frozen = frozen;
+    }
+    /// Translational + rotational kinetic energy.
+    pub fn kinetic_energy(&self) -> f64 {
+        let (m, i) = (self.p.mass, self.p.inertia);
+        let sq = |a: &V3| a[0] * a[0] + a[1] * a[1] + a[2] * a[2];
+        self.v.iter().map(|a| 0.5 * m * sq(a)).sum::<f64>() + self.w.iter().map(|a| 0.5 * i * sq(a)).sum::<f64>()
+    }
+
+    /// Elastic energy of the normal springs, Σ 2/5 K_n δ^{5/2} over pairs and walls.
+    pub fn elastic_energy(&self) -> f64 {
+        let (r, x) = (self.p.radius, &self.x);
+        let mut e = 0.0;
+        for i in 0..x.len() {
+            for k in self.nl.offsets[i] as usize..self.nl.offsets[i + 1] as usize {
+                let j = self.nl.nbr[k] as usize;
+                let d = ((0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum::<f64>()).sqrt();
+                e += self.p.pair.elastic_energy((2.0 * r - d).max(0.0));
+            }
+            let rho = (x[i][0].powi(2) + x[i][1].powi(2)).sqrt();
+            let mut walls = vec![r - x[i][2], rho + r - self.p.tube_radius];
+            if self.p.lid {
+                walls.push(x[i][2] + r - self.p.height);
+            }
+            e += walls.into_iter().map(|d| self.p.wall.elastic_energy(d.max(0.0))).sum::<f64>();
+        }
+        e
+    }
+
+    /// Largest overlap over the diameter in the last step (pairs and walls).
+    pub fn max_overlap_fraction(&self) -> f64 {
+        self.last.0 / (2.0 * self.p.radius)
+    }
+
+    /// Largest |F_t|² − (μ F_n)² over all contacts in the last step (≤ round-off when the
+    /// Coulomb limit holds; −∞ without frictional contacts). For tests and diagnostics.
+    pub fn max_coulomb_excess(&self) -> f64 {
+        self.last.1
+    }
+
+    /// One DEM step of the case's time step (uses the current rayon pool).
+    pub fn step(&mut self) {
+        if !self.frozen && !self.x.is_empty() {
+            if self.p.friction {
+                self.advance::<true>();
+            } else {
+                self.advance::<false>();
+            }
+        }
+        self.steps += 1;
+        self.time += self.p.dt;
+    }
+
+    fn advance<const FR: bool>(&mut self) {
+        let np = self.nl.nbr.len();
+        if self.pf.len() != np {
+            self.pf = vec![[0.0; 3]; np];
+        }
+        if FR && self.pc.len() != np {
+            self.pc = vec![[0.0; 3]; np];
+        }
+        if self.nl.rev_offsets.len() != self.x.len() + 1 {
+            self.nl.build_reverse(self.x.len()); // after a restore (the transpose is not stored)
+        }
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.pf, &mut self.pc);
+        let st2 = if self.levels == 0 {
+            self.heun::<FR>()
+        } else {
+            let h = self.p.dt;
+            let b = weights(self.levels);
+            let hb = [h * b[0], h * b[1], h * b[2]];
+            let (x, v, w, past) = (&mut self.x, &mut self.v, &mut self.w, &mut self.past);
+            let st = update_pass::<FR>(&self.p, hb, x, v, w, past, &self.ext, &self.nl, &self.pf, &self.pc);
+            self.levels = (self.levels + 1).min(3);
+            st
+        };
+        let st = st1.max(st2);
+        self.last = (st.overlap, st.coulomb_excess);
+        if st.disp2 > 0.25 * self.p.skin * self.p.skin {
+            self.rebuild_due = true;
+        }
+        if self.rebuild_due {
+            self.rebuild();
+        }
+    }
+
+    /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
+    /// contact histories keep the values of the first evaluation (they are integrated by Euler).
+    fn heun<const FR: bool>(&mut self) -> Stats {
+        let n = self.x.len();
+        let h = self.p.dt;
+        let (mut a0, mut l0) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let st = accel_pass::<FR>(
+            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.nl, &self.pf, &self.pc, &mut a0, &mut l0,
+        );
+        let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
+        let (shear1, past1) = (self.nl.shear.clone(), self.past.clone());
+        let step = |y: &V3, f: &V3, c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
+        for i in 0..n {
+            self.x[i] = step(&x0[i], &v0[i], h);
+            self.v[i] = step(&v0[i], &a0[i], h);
+            self.w[i] = step(&w0[i], &l0[i], h);
+        }
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.pf, &mut self.pc);
+        let (mut a1, mut l1) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        accel_pass::<FR>(
+            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.nl, &self.pf, &self.pc, &mut a1, &mut l1,
+        );
+        self.nl.shear = shear1;
+        self.past = past1;
+        let mut disp2: f64 = 0.0;
+        for i in 0..n {
+            let vs = self.v[i];
+            self.x[i] = step(&step(&x0[i], &v0[i], 0.5 * h), &vs, 0.5 * h);
+            self.v[i] = step(&step(&v0[i], &a0[i], 0.5 * h), &a1[i], 0.5 * h);
+            if FR {
+                self.w[i] = step(&step(&w0[i], &l0[i], 0.5 * h), &l1[i], 0.5 * h);
+            }
+            let q = &mut self.past[i];
+            q.v[0] = v0[i];
+            q.a[0] = a0[i];
+            q.alpha[0] = l0[i];
+            let d: f64 = (0..3).map(|k| (self.x[i][k] - q.x_build[k]).powi(2)).sum();
+            disp2 = disp2.max(d);
+        }
+        self.levels = 2;
+        Stats { disp2, ..st }
+    }
+
+    /// Re-sort particles by linked cell, rebuild the half list, carry contact history by id.
+    fn rebuild(&mut self) {
+        let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
+        let perm = |src: &Vec<V3>| -> Vec<V3> { order.iter().map(|&o| src[o as usize]).collect() };
+        self.x = perm(&self.x);
+        self.v = perm(&self.v);
+        self.w = perm(&self.w);
+        self.ext = perm(&self.ext);
+        self.past = order.iter().map(|&o| self.past[o as usize]).collect();
+        let old_ids = std::mem::take(&mut self.ids);
+        self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
+        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff);
+        if self.p.friction {
+            nl.carry_history(&self.nl, &old_ids, &self.ids);
+        }
+        self.nl = nl;
+        for (q, x) in self.past.iter_mut().zip(&self.x) {
+            q.x_build = *x;
+        }
+        self.rebuild_due = false;
+    }
+}

@@ -1,0 +1,37 @@
+//! DEM tests: each compares with an analytic or published value (PHYSICS.md 2, 7; textbook
+//! mechanics) and stays small enough to run in seconds.
+
+mod checkpoint;
+mod energy;
+mod integrator_order;
+mod poured_bed;
+mod restitution;
+mod sliding;
+
+use crate::case::{Bed, Case, Column, Damping, ExplicitBed, Particles};
+
+/// A case with the paper's particles in a column of diameter `col_d` and height `height`.
+pub fn test_case(col_d: f64, height: f64, lid: bool, gravity: f64, dt: f64) -> Case {
+    let mut c = Case {
+        name: "dem test".into(),
+        column: Column { diameter_m: col_d, height_m: height, lid },
+        particles: Particles::default(),
+        bed: Bed::Explicit(ExplicitBed { positions_m: vec![], velocities_m_s: None }),
+        gravity_m_s2: gravity,
+        dem: Default::default(),
+        end_time_s: 1.0,
+        outputs: Default::default(),
+        gas: None,
+        grid: Default::default(),
+        voidage: Default::default(),
+    };
+    c.dem.time_step_s = dt;
+    c
+}
+
+pub fn with_damping(mut c: Case, alpha_n: f64, alpha_t: f64, mu: f64) -> Case {
+    c.particles.normal_damping = Damping::TsujiAlpha(alpha_n);
+    c.particles.tangential_damping = Damping::TsujiAlpha(alpha_t);
+    c.particles.sliding_friction = mu;
+    c
+}
