@@ -1,20 +1,4 @@
-//! fluidbed: the command-line client.
+//! fluidbed: the command-line client (see `fluidbed --help`).
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    if args.len() == 3 && args[1] == "validate" {
-        let text = std::fs::read_to_string(&args[2]).expect("read case");
-        match fluidbed_core::case::Case::parse_str(&text) {
-            Ok((_, rep)) => {
-                for w in rep.warnings { eprintln!("warning: {w}"); }
-                println!("ok");
-            }
-            Err(rep) => {
-                for e in rep.errors { eprintln!("error: {e}"); }
-                std::process::exit(2);
-            }
-        }
-    } else {
-        eprintln!("usage: fluidbed validate CASE.json");
-        std::process::exit(64);
-    }
+    std::process::exit(fluidbed::cli::main_with(std::env::args_os()));
 }

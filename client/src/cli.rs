@@ -1,0 +1,257 @@
+//! The command line: verbs map one-to-one to the HTTP API; `run` = submit + watch + fetch.
+
+use crate::api::{Api, ApiError};
+use crate::exit;
+use crate::fetch::{fetch, Formats};
+use crate::watch::watch;
+use clap::{Parser, Subcommand};
+use serde_json::{json, Value};
+use std::ffi::OsString;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser)]
+#[command(name = "fluidbed", version, about = "Run and fetch fluidbed DEM-CFD jobs", after_help = EXIT_HELP)]
+struct Cli {
+    /// Server URL; without it `run` starts an embedded server on a free loopback port.
+    #[arg(long, global = true, env = "FLUIDBED_SERVER")]
+    server: Option<String>,
+    /// Bearer token for a server started with --token.
+    #[arg(long, global = true, env = "FLUIDBED_TOKEN")]
+    token: Option<String>,
+    /// Machine-readable output (JSON) instead of text and progress bars.
+    #[arg(long, global = true)]
+    json: bool,
+    #[command(subcommand)]
+    verb: Verb,
+}
+
+const EXIT_HELP: &str = "Exit codes: 0 success, 2 invalid case, 3 job failed or cancelled, 4 server or connection error, 64 bad command line.";
+
+#[derive(Subcommand)]
+enum Verb {
+    /// Check a case locally (the same checks and messages as the server).
+    Validate { case: PathBuf },
+    /// Submit a case; prints the job id.
+    Submit { case: PathBuf },
+    /// List jobs, newest first.
+    List {
+        #[arg(long)]
+        status: Option<String>,
+        #[arg(long, default_value_t = 20)]
+        limit: usize,
+    },
+    /// Show a job's status.
+    Status { id: String },
+    /// Follow a job to its end with a progress bar (ETA, latest ΔP).
+    Watch { id: String },
+    /// Download results into a folder.
+    Fetch {
+        id: String,
+        #[arg(long, default_value = "fluidbed-out")]
+        out: PathBuf,
+        /// Per-snapshot encodings: npy, vtk, json (comma separated).
+        #[arg(long, default_value = "npy,vtk")]
+        formats: String,
+    },
+    /// Cancel a job.
+    Cancel { id: String },
+    /// Submit, watch and fetch; with no --server, on an embedded server.
+    Run {
+        case: PathBuf,
+        /// Output folder (default ./fluidbed-out/<case file name>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        #[arg(long, default_value = "npy,vtk")]
+        formats: String,
+        /// Threads for the job on the embedded server (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+}
+
+/// Run the CLI with these arguments (argv[0] first); returns the exit code.
+pub fn main_with<I: IntoIterator<Item = T>, T: Into<OsString> + Clone>(args: I) -> i32 {
+    let cli = match Cli::try_parse_from(args) {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return if e.use_stderr() { exit::USAGE } else { exit::OK };
+        }
+    };
+    if let Verb::Validate { case } = &cli.verb {
+        return validate(case, cli.json).0;
+    }
+    let rt = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+        Ok(rt) => rt,
+        Err(e) => return fail(exit::SERVER, &format!("cannot start the async runtime: {e}")),
+    };
+    rt.block_on(dispatch(cli))
+}
+
+pub(crate) fn fail(code: i32, msg: &str) -> i32 {
+    eprintln!("fluidbed: {msg}");
+    code
+}
+
+pub(crate) fn api_fail(e: ApiError, json_out: bool) -> i32 {
+    match &e {
+        ApiError::Invalid(p) => {
+            if json_out {
+                println!("{p}");
+            } else {
+                for err in p["errors"].as_array().into_iter().flatten() {
+                    eprintln!("error: {}: {} (got {}; allowed: {})", err["pointer"].as_str().unwrap_or(""), err["message"].as_str().unwrap_or(""), err["value"], err["allowed"].as_str().unwrap_or(""));
+                }
+            }
+            exit::INVALID_CASE
+        }
+        ApiError::Server(m) => fail(exit::SERVER, m),
+    }
+}
+
+/// Local validation: (exit code, case JSON text when valid).
+pub(crate) fn validate(path: &Path, json_out: bool) -> (i32, Option<(String, String)>) {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) => return (fail(exit::INVALID_CASE, &format!("cannot read {}: {e}", path.display())), None),
+    };
+    match fluidbed_core::case::Case::parse_str(&text) {
+        Ok((case, report)) => {
+            if json_out {
+                println!("{}", json!({ "valid": true, "warnings": report.warnings }));
+            }
+            for w in &report.warnings {
+                eprintln!("warning: {w}");
+            }
+            (exit::OK, Some((text, case.name)))
+        }
+        Err(report) => {
+            if json_out {
+                println!("{}", json!({ "valid": false, "errors": report.errors, "warnings": report.warnings }));
+            }
+            for e in &report.errors {
+                eprintln!("error: {e}");
+            }
+            (exit::INVALID_CASE, None)
+        }
+    }
+}
+
+fn print_job(j: &Value, json_out: bool) {
+    if json_out {
+        println!("{j}");
+    } else {
+        let eta = j["eta_s"].as_f64().map(|e| format!(", ETA {e:.0} s")).unwrap_or_default();
+        let msg = j["message"].as_str().map(|m| format!(" — {m}")).unwrap_or_default();
+        println!(
+            "{}  {:9}  {:5.1}%  t = {:.4}/{:.4} s  {} steps  {:.1} s wall{eta}  {}{msg}",
+            j["id"].as_str().unwrap_or(""),
+            j["status"].as_str().unwrap_or(""),
+            100.0 * j["progress"].as_f64().unwrap_or(0.0),
+            j["time_s"].as_f64().unwrap_or(0.0),
+            j["end_time_s"].as_f64().unwrap_or(0.0),
+            j["steps"],
+            j["wall_time_s"].as_f64().unwrap_or(0.0),
+            j["name"].as_str().unwrap_or("")
+        );
+    }
+}
+
+pub(crate) fn outcome_code(status: &str) -> i32 {
+    if status == "succeeded" {
+        exit::OK
+    } else {
+        exit::JOB_FAILED
+    }
+}
+
+async fn dispatch(cli: Cli) -> i32 {
+    let token = cli.token.clone().filter(|t| !t.is_empty());
+    let server = cli.server.clone().unwrap_or_else(|| "http://127.0.0.1:8471".into());
+    let api = match Api::new(&server, token.as_deref()) {
+        Ok(a) => a,
+        Err(e) => return fail(exit::USAGE, &format!("bad --server or --token: {e}")),
+    };
+    let j = cli.json;
+    match cli.verb {
+        Verb::Validate { .. } => exit::OK,
+        Verb::Submit { case } => {
+            let (code, ok) = validate(&case, false);
+            let Some((text, _)) = ok else { return code };
+            match api.submit(&text).await {
+                Ok(job) if j => {
+                    println!("{job}");
+                    exit::OK
+                }
+                Ok(job) => {
+                    println!("{}", job["id"].as_str().unwrap_or(""));
+                    exit::OK
+                }
+                Err(e) => api_fail(e, j),
+            }
+        }
+        Verb::List { status, limit } => {
+            let q = status.map(|s| format!("&status={s}")).unwrap_or_default();
+            match api.get_json(&format!("/v1/jobs?limit={limit}{q}")).await {
+                Ok(v) if j => {
+                    println!("{v}");
+                    exit::OK
+                }
+                Ok(v) => {
+                    v["jobs"].as_array().into_iter().flatten().for_each(|job| print_job(job, false));
+                    exit::OK
+                }
+                Err(e) => api_fail(e, j),
+            }
+        }
+        Verb::Status { id } => match api.get_json(&format!("/v1/jobs/{id}")).await {
+            Ok(v) => {
+                print_job(&v, j);
+                exit::OK
+            }
+            Err(e) => api_fail(e, j),
+        },
+        Verb::Watch { id } => match watch(&api, &id, j).await {
+            Ok(o) => {
+                report_outcome(&id, &o.status, o.message.as_deref(), j);
+                outcome_code(&o.status)
+            }
+            Err(e) => api_fail(e, j),
+        },
+        Verb::Fetch { id, out, formats } => {
+            let f = match Formats::parse(&formats) {
+                Ok(f) => f,
+                Err(m) => return fail(exit::USAGE, &m),
+            };
+            match fetch(&api, &id, &out, &f).await {
+                Ok(files) => {
+                    if j {
+                        println!("{}", json!({ "id": id, "files": files }));
+                    } else {
+                        println!("{} files in {}", files.len(), out.display());
+                    }
+                    exit::OK
+                }
+                Err(e) => api_fail(e, j),
+            }
+        }
+        Verb::Cancel { id } => match api.cancel(&id).await {
+            Ok(v) => {
+                print_job(&v, j);
+                exit::OK
+            }
+            Err(e) => api_fail(e, j),
+        },
+        Verb::Run { case, out, formats, threads } => crate::cli_run::run(cli.server.is_some().then_some(api), token, case, out, formats, threads, j).await,
+    }
+}
+
+pub(crate) fn report_outcome(id: &str, status: &str, message: Option<&str>, json_out: bool) {
+    if json_out {
+        println!("{}", json!({ "id": id, "status": status, "message": message }));
+    } else {
+        let m = message.map(|m| format!(": {m}")).unwrap_or_default();
+        eprintln!("job {id} {status}{m}");
+    }
+}
+

@@ -1,0 +1,92 @@
+//! `fluidbed run`: submit, watch, fetch. Without `--server` it starts an embedded server
+//! in-process on a free loopback port (data in `<out>/server-data/`, fresh for each run) and
+//! talks to it over HTTP like to any other server.
+
+use crate::api::Api;
+use crate::cli::{api_fail, fail, outcome_code, report_outcome, validate};
+use crate::exit;
+use crate::fetch::{fetch, Formats};
+use crate::watch::watch;
+use serde_json::json;
+use std::path::PathBuf;
+
+pub async fn run(server: Option<Api>, token: Option<String>, case: PathBuf, out: Option<PathBuf>, formats: String, threads: Option<usize>, json_out: bool) -> i32 {
+    let formats = match Formats::parse(&formats) {
+        Ok(f) => f,
+        Err(m) => return fail(exit::USAGE, &m),
+    };
+    let (code, ok) = validate(&case, false);
+    let Some((text, _name)) = ok else { return code };
+    let stem = case.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
+    let out = out.unwrap_or_else(|| PathBuf::from("fluidbed-out").join(&stem));
+    let (api, embedded) = match server {
+        Some(api) => (api, None),
+        None => match start_embedded(&out, threads, token.as_deref()) {
+            Ok(pair) => pair,
+            Err(code) => return code,
+        },
+    };
+    if !json_out {
+        eprintln!("fluidbed: running {} on {}", case.display(), api.base);
+    }
+    let code = submit_watch_fetch(&api, &text, &out, &formats, json_out).await;
+    #[cfg(feature = "embedded")]
+    if let Some(s) = embedded {
+        let _ = tokio::task::spawn_blocking(move || s.shutdown()).await;
+    }
+    #[cfg(not(feature = "embedded"))]
+    let _ = embedded;
+    code
+}
+
+async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, formats: &Formats, json_out: bool) -> i32 {
+    let job = match api.submit(text).await {
+        Ok(j) => j,
+        Err(e) => return api_fail(e, json_out),
+    };
+    let id = job["id"].as_str().unwrap_or("").to_string();
+    if !json_out {
+        eprintln!("fluidbed: job {id} submitted");
+    }
+    let outcome = match watch(api, &id, json_out).await {
+        Ok(o) => o,
+        Err(e) => return api_fail(e, json_out),
+    };
+    // Fetch what exists even when the job failed: the last good snapshots are kept.
+    let files = match fetch(api, &id, out, formats).await {
+        Ok(f) => f,
+        Err(e) => return api_fail(e, json_out),
+    };
+    report_outcome(&id, &outcome.status, outcome.message.as_deref(), false);
+    if json_out {
+        println!("{}", json!({ "id": id, "status": outcome.status, "message": outcome.message, "out": out, "files": files }));
+    } else {
+        eprintln!("fluidbed: {} files in {}", files.len(), out.display());
+    }
+    outcome_code(&outcome.status)
+}
+
+#[cfg(feature = "embedded")]
+type Embedded = fluidbed_server::Server;
+#[cfg(not(feature = "embedded"))]
+type Embedded = ();
+
+#[cfg(feature = "embedded")]
+fn start_embedded(out: &std::path::Path, threads: Option<usize>, token: Option<&str>) -> Result<(Api, Option<Embedded>), i32> {
+    let data = out.join("server-data");
+    if data.exists() {
+        std::fs::remove_dir_all(&data).map_err(|e| fail(exit::SERVER, &format!("cannot clear {}: {e}", data.display())))?;
+    }
+    let mut cfg = fluidbed_server::Config::new(data);
+    cfg.listen = std::net::SocketAddr::from(([127, 0, 0, 1], 0));
+    cfg.threads_per_job = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    cfg.token = token.map(str::to_string);
+    let server = fluidbed_server::Server::start(cfg).map_err(|e| fail(exit::SERVER, &format!("cannot start the embedded server: {e:#}")))?;
+    let api = Api::new(&server.url(), token).map_err(|e| fail(exit::SERVER, &e.to_string()))?;
+    Ok((api, Some(server)))
+}
+
+#[cfg(not(feature = "embedded"))]
+fn start_embedded(_out: &std::path::Path, _threads: Option<usize>, _token: Option<&str>) -> Result<(Api, Option<Embedded>), i32> {
+    Err(fail(exit::USAGE, "this build has no embedded server (feature `embedded`): pass --server URL"))
+}
