@@ -1,1 +1,9 @@
 //! Voidage methods, drag laws and the particle-gas force exchange (paper section 2.3).
+
+pub mod drag;
+pub mod exchange;
+pub mod voidage;
+
+pub use drag::{beetstra_f, beta_a, drag_force};
+pub use exchange::{particle_gas_forces, GasAtCells};
+pub use voidage::{build_voidage, voidage_from_solid, VoidageMethod};

@@ -1,0 +1,117 @@
+//! Square-grid method (paper section 2.3, eq. 8–9): particle volume is split over boxes of side
+//! dl_xy × dl_xy × dz (aligned with the fluid layers) by the cuboid approximation (PHYSICS.md 4)
+//! or exactly (PHYSICS.md 3), then mapped to the cells with the box→cell fractions of `BoxGrid`.
+
+use super::box_grid::BoxGrid;
+use super::cuboid::{cell_of, interval_split, MAX_SPAN};
+use super::sphere_box::sphere_box_volume;
+use super::{Scatter, VoidageMethod};
+use crate::case::BoxSplit;
+use crate::grid::CylGrid;
+use std::f64::consts::PI;
+
+pub struct SquareGrid {
+    grid: CylGrid,
+    boxes: BoxGrid,
+    split: BoxSplit,
+    cube_side_factor: f64,
+    scatter: Scatter<()>,
+}
+
+impl SquareGrid {
+    pub fn new(grid: &CylGrid, box_side: f64, split: BoxSplit, cube_side_factor: f64) -> Self {
+        SquareGrid {
+            grid: grid.clone(),
+            boxes: BoxGrid::new(grid, box_side),
+            split,
+            cube_side_factor,
+            scatter: Scatter::new(grid.num_cells(), || ()),
+        }
+    }
+    pub fn box_grid(&self) -> &BoxGrid {
+        &self.boxes
+    }
+}
+
+impl VoidageMethod for SquareGrid {
+    fn name(&self) -> &'static str {
+        match self.split {
+            BoxSplit::Cuboid => "square_grid_cuboid",
+            BoxSplit::Exact => "square_grid_exact",
+        }
+    }
+    fn solid_volume(&mut self, positions: &[[f64; 3]], radius: f64, out: &mut [f64]) {
+        let (g, bg) = (&self.grid, &self.boxes);
+        match self.split {
+            BoxSplit::Cuboid => {
+                let h = self.cube_side_factor * 2.0 * radius;
+                self.scatter.run(positions, out, |p, buf, _| cuboid_particle(g, bg, p, radius, h, buf))
+            }
+            BoxSplit::Exact => self.scatter.run(positions, out, |p, buf, _| exact_particle(g, bg, p, radius, buf)),
+        }
+    }
+}
+
+/// Cube of side h: separable shares per axis (PHYSICS.md 4), then box → cells.
+fn cuboid_particle(g: &CylGrid, bg: &BoxGrid, p: &[f64; 3], radius: f64, h: f64, out: &mut [f64]) {
+    let vp = 4.0 / 3.0 * PI * radius.powi(3);
+    let mut fx = [(0, 0.0); MAX_SPAN];
+    let mut fy = [(0, 0.0); MAX_SPAN];
+    let mut fz = [(0, 0.0); MAX_SPAN];
+    let nx = interval_split(p[0], h, bg.origin, bg.dl, bg.nb, &mut fx);
+    let ny = interval_split(p[1], h, bg.origin, bg.dl, bg.nb, &mut fy);
+    let nz = interval_split(p[2], h, 0.0, g.dz, g.nz, &mut fz);
+    let per = g.cells_per_layer();
+    for &(by, sy) in &fy[..ny] {
+        for &(bx, sx) in &fx[..nx] {
+            let cells = bg.cells_of(bx, by);
+            for &(k, sz) in &fz[..nz] {
+                let v = vp * sx * sy * sz;
+                let base = k * per;
+                for &(c, f) in cells {
+                    out[base + c as usize] += v * f;
+                }
+            }
+        }
+    }
+}
+
+/// Exact sphere ∩ box volumes (PHYSICS.md 3); the end boxes and layers reach to infinity so
+/// nothing is lost, and the shares are normalised to V_p against round-off.
+fn exact_particle(g: &CylGrid, bg: &BoxGrid, p: &[f64; 3], radius: f64, out: &mut [f64]) {
+    let vp = 4.0 / 3.0 * PI * radius.powi(3);
+    let bounds = |idx: usize, origin: f64, dl: f64, n: usize| {
+        let lo = if idx == 0 { f64::NEG_INFINITY } else { origin + idx as f64 * dl };
+        let hi = if idx + 1 == n { f64::INFINITY } else { origin + (idx + 1) as f64 * dl };
+        (lo, hi)
+    };
+    let span = |x: f64, origin: f64, dl: f64, n: usize| (cell_of(x - radius, origin, dl, n), cell_of(x + radius, origin, dl, n));
+    let (x0, x1) = span(p[0], bg.origin, bg.dl, bg.nb);
+    let (y0, y1) = span(p[1], bg.origin, bg.dl, bg.nb);
+    let (z0, z1) = span(p[2], 0.0, g.dz, g.nz);
+    let mut parts = [(0usize, 0usize, 0usize, 0.0f64); MAX_SPAN * MAX_SPAN * 2];
+    let mut m = 0;
+    let mut total = 0.0;
+    for k in z0..=z1 {
+        let (zl, zh) = bounds(k, 0.0, g.dz, g.nz);
+        for by in y0..=y1 {
+            let (yl, yh) = bounds(by, bg.origin, bg.dl, bg.nb);
+            for bx in x0..=x1 {
+                let (xl, xh) = bounds(bx, bg.origin, bg.dl, bg.nb);
+                let v = sphere_box_volume(*p, radius, [xl, yl, zl], [xh, yh, zh]);
+                if v > 0.0 && m < parts.len() {
+                    parts[m] = (bx, by, k, v);
+                    m += 1;
+                    total += v;
+                }
+            }
+        }
+    }
+    let per = g.cells_per_layer();
+    for &(bx, by, k, v) in &parts[..m] {
+        let v = v * vp / total;
+        for &(c, f) in bg.cells_of(bx, by) {
+            out[k * per + c as usize] += v * f;
+        }
+    }
+}
