@@ -1,1 +1,139 @@
-//! End-to-end tests live in tests/tests/.
+//! Helpers for the end-to-end tests in tests/tests/: a real server on a free loopback port with a
+//! real data directory, small cases, and an event-stream reader.
+
+use fluidbed_server::{Config, Server};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+pub use fluidbed::watch::{parse_events, SseEvent};
+
+/// A temporary folder removed on drop.
+pub struct TempDir(pub PathBuf);
+
+impl TempDir {
+    pub fn new(tag: &str) -> TempDir {
+        let p = std::env::temp_dir().join(format!("fluidbed-e2e-{tag}-{}-{:x}", std::process::id(), rand_u64()));
+        std::fs::create_dir_all(&p).expect("create temp dir");
+        TempDir(p)
+    }
+    pub fn path(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn rand_u64() -> u64 {
+    use std::hash::{BuildHasher, Hasher};
+    let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+    h.write_u64(Instant::now().elapsed().as_nanos() as u64);
+    h.finish()
+}
+
+/// Start a server on 127.0.0.1:0 over `data_dir`.
+pub fn start(data_dir: &Path, token: Option<&str>) -> Server {
+    let mut cfg = Config::new(data_dir.to_path_buf());
+    cfg.listen = "127.0.0.1:0".parse().expect("addr");
+    cfg.token = token.map(str::to_string);
+    cfg.workers = 1;
+    cfg.threads_per_job = 1;
+    cfg.max_body_bytes = 256 * 1024;
+    Server::start(cfg).expect("server starts")
+}
+
+/// Diameter of the test particles.
+pub const D: f64 = 0.0012;
+
+/// A DEM-only case: `nx`×`nx`×`layers` particles on a square lattice (spacing 1.5 d) released
+/// above the distributor of a 44-mm column; direct voidage, voidage and particles stored.
+pub fn lattice_case(nx: usize, layers: usize, end_time_s: f64, snapshot_interval_s: f64) -> Value {
+    let mut pos = Vec::new();
+    let s = 1.5 * D;
+    for k in 0..layers {
+        for j in 0..nx {
+            for i in 0..nx {
+                let x = (i as f64 - (nx as f64 - 1.0) / 2.0) * s + 0.0001 * k as f64;
+                let y = (j as f64 - (nx as f64 - 1.0) / 2.0) * s;
+                pos.push([x, y, 0.003 + k as f64 * s]);
+            }
+        }
+    }
+    json!({
+        "name": "e2e lattice",
+        "column": { "diameter_m": 0.044, "height_m": 0.044 },
+        "particles": { "diameter_m": D, "density_kg_m3": 1000.0 },
+        "bed": { "explicit": { "positions_m": pos } },
+        "end_time_s": end_time_s,
+        "outputs": { "snapshot_interval_s": snapshot_interval_s, "fields": ["voidage", "particles"] },
+        "voidage": { "method": "direct" }
+    })
+}
+
+/// Poll a job until its status is final (or `timeout` passes); the last job document.
+pub async fn wait_final(http: &reqwest::Client, job_url: &str, timeout: Duration) -> Value {
+    let t0 = Instant::now();
+    loop {
+        let j: Value = http.get(job_url).send().await.expect("get job").json().await.expect("job json");
+        let st = j["status"].as_str().unwrap_or("");
+        if matches!(st, "succeeded" | "failed" | "cancelled") || t0.elapsed() > timeout {
+            return j;
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// Poll until the job lists at least `n` snapshots while running; false if it ended first.
+pub async fn wait_snapshots(http: &reqwest::Client, job_url: &str, n: usize, timeout: Duration) -> bool {
+    let t0 = Instant::now();
+    while t0.elapsed() < timeout {
+        let l: Value = http.get(format!("{job_url}/snapshots")).send().await.expect("list").json().await.expect("json");
+        if l["snapshots"].as_array().map_or(0, Vec::len) >= n {
+            return true;
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
+    false
+}
+
+/// Read a job's event stream until it closes (it closes after the `end` event).
+pub async fn read_events(http: &reqwest::Client, job_url: &str, last_event_id: Option<&str>) -> Vec<SseEvent> {
+    use futures_util::StreamExt;
+    let mut req = http.get(format!("{job_url}/events"));
+    if let Some(l) = last_event_id {
+        req = req.header("Last-Event-ID", l);
+    }
+    let resp = req.send().await.expect("events");
+    assert_eq!(resp.status(), 200);
+    assert!(resp.headers()["content-type"].to_str().unwrap_or("").starts_with("text/event-stream"));
+    let mut stream = resp.bytes_stream();
+    let (mut buf, mut out) = (String::new(), Vec::new());
+    while let Some(chunk) = stream.next().await {
+        buf.push_str(&String::from_utf8_lossy(&chunk.expect("chunk")));
+        out.extend(parse_events(&mut buf));
+    }
+    out
+}
+
+/// Every file under `dir`, relative, sorted.
+pub fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                out.push(p.strip_prefix(dir).unwrap_or(&p).to_path_buf());
+                stack.push(p);
+            } else {
+                out.push(p.strip_prefix(dir).unwrap_or(&p).to_path_buf());
+            }
+        }
+    }
+    out.sort();
+    out
+}
