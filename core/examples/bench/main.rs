@@ -2,11 +2,13 @@
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
 mod dem;
+mod voidage;
 
 fn main() {
     let what = std::env::args().nth(1).unwrap_or_else(|| "all".into());
     match what.as_str() {
         "dem" => dem::run(),
+        "voidage" => voidage::run(),
         other => {
             eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage or all");
             std::process::exit(2);
