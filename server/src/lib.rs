@@ -36,6 +36,8 @@ pub struct Config {
     pub max_body_bytes: usize,
     /// Most jobs waiting in the queue; more are answered 429.
     pub max_queued: usize,
+    /// Sustained job submissions per second (token bucket, burst of 4 seconds' worth); more are 429.
+    pub submissions_per_s: f64,
 }
 
 impl Config {
@@ -48,6 +50,7 @@ impl Config {
             threads_per_job: 1,
             max_body_bytes: 16 << 20,
             max_queued: 64,
+            submissions_per_s: 5.0,
         }
     }
 }
@@ -59,6 +62,8 @@ pub struct App {
     pub hub: events::Hub,
     pub queue: worker::Queue,
     pub cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
+    /// Submission token bucket: (tokens, last refill).
+    submit_bucket: Mutex<(f64, Instant)>,
     stopping: AtomicBool,
 }
 
@@ -67,6 +72,23 @@ impl App {
     /// resumed from their checkpoint by the next server on this data directory.
     pub fn stopping(&self) -> bool {
         self.stopping.load(Ordering::SeqCst)
+    }
+    /// Take one submission token; false when the client must slow down.
+    pub fn take_submission_token(&self) -> bool {
+        let rate = self.config.submissions_per_s;
+        if rate <= 0.0 {
+            return true;
+        }
+        let mut b = self.submit_bucket.lock().unwrap_or_else(|e| e.into_inner());
+        let now = Instant::now();
+        b.0 = (b.0 + rate * now.duration_since(b.1).as_secs_f64()).min(4.0 * rate);
+        b.1 = now;
+        if b.0 >= 1.0 {
+            b.0 -= 1.0;
+            true
+        } else {
+            false
+        }
     }
 }
 
@@ -88,6 +110,7 @@ impl Server {
             hub: events::Hub::default(),
             queue: worker::Queue::default(),
             cancels: Mutex::new(HashMap::new()),
+            submit_bucket: Mutex::new((4.0 * config.submissions_per_s, Instant::now())),
             stopping: AtomicBool::new(false),
             config,
         });

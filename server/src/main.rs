@@ -29,6 +29,9 @@ struct Args {
     /// Most jobs waiting; more are refused with 429.
     #[arg(long, default_value_t = 64)]
     max_queued: usize,
+    /// Sustained job submissions per second (bursts of 4 s worth); 0 = unlimited.
+    #[arg(long, default_value_t = 5.0)]
+    submissions_per_s: f64,
 }
 
 fn default_threads() -> usize {
@@ -45,6 +48,7 @@ fn main() -> anyhow::Result<()> {
         threads_per_job: a.threads_per_job,
         max_body_bytes: a.max_body_bytes,
         max_queued: a.max_queued,
+        submissions_per_s: a.submissions_per_s,
     };
     let dir = cfg.data_dir.clone();
     let server = Server::start(cfg)?;

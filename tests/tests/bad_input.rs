@@ -80,3 +80,29 @@ async fn a_token_guards_every_route_but_healthz() {
     assert_eq!(listed["total"], 0, "the refused POST created no job");
     server.shutdown();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_full_queue_answers_429_with_retry_after() {
+    let dir = TempDir::new("queue");
+    let mut cfg = fluidbed_server::Config::new(dir.path().to_path_buf());
+    cfg.listen = "127.0.0.1:0".parse().unwrap();
+    cfg.max_queued = 1;
+    let server = fluidbed_server::Server::start(cfg).unwrap();
+    let http = reqwest::Client::new();
+    let long = lattice_case(2, 1, 50.0, 0.01);
+    let mut codes = Vec::new();
+    for _ in 0..3 {
+        let r = http.post(format!("{}/v1/jobs", server.url())).json(&long).send().await.unwrap();
+        if r.status() == 429 {
+            assert!(r.headers().contains_key("retry-after"));
+        }
+        codes.push(r.status().as_u16());
+    }
+    assert_eq!(codes[0], 201);
+    assert!(codes.contains(&429), "{codes:?}");
+    let listed: Value = http.get(format!("{}/v1/jobs", server.url())).send().await.unwrap().json().await.unwrap();
+    for j in listed["jobs"].as_array().unwrap() {
+        http.delete(format!("{}/v1/jobs/{}", server.url(), j["id"].as_str().unwrap())).send().await.unwrap();
+    }
+    server.shutdown();
+}

@@ -29,6 +29,11 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
         }
         Err(e) => return problem(e.status(), "Unreadable request body", &e.body_text()),
     };
+    if !app.take_submission_token() {
+        let mut r = problem(StatusCode::TOO_MANY_REQUESTS, "Too many submissions", "slow down: the server accepts a few jobs per second");
+        r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("1"));
+        return r;
+    }
     let value: serde_json::Value = match serde_json::from_slice(&body) {
         Ok(v) => v,
         Err(e) => return problem(StatusCode::BAD_REQUEST, "Malformed JSON", &format!("the body is not valid JSON: {e}")),
