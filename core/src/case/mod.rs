@@ -245,6 +245,10 @@ pub struct Gas {
     /// Lower clamp of ε in the drag law (PHYSICS.md 1.1).
     #[serde(default = "d_eps_min")]
     pub drag_voidage_min: f64,
+    /// Safety factor on the largest stable gas step (acoustic CFL inside AB3's stability
+    /// region, PHYSICS.md 7); the stable step is this factor times the limit.
+    #[serde(default = "d_cfl")]
+    pub cfl_factor: f64,
 }
 
 impl Default for Gas {
@@ -261,6 +265,7 @@ impl Default for Gas {
             outlet_relaxation: d_sigma(),
             time_step_s: None,
             drag_voidage_min: d_eps_min(),
+            cfl_factor: d_cfl(),
         }
     }
 }
@@ -428,6 +433,9 @@ fn d_sigma() -> f64 {
 }
 fn d_eps_min() -> f64 {
     0.1
+}
+fn d_cfl() -> f64 {
+    0.9
 }
 fn d_n0() -> usize {
     3

@@ -228,8 +228,23 @@ impl Case {
         r.range("/gas/inlet_voidage", g.inlet_voidage, 0.0, true, 1.0, false, "inlet voidage");
         r.range("/gas/outlet_relaxation", g.outlet_relaxation, 0.0, false, 10.0, false, "outlet relaxation σ");
         r.range("/gas/drag_voidage_min", g.drag_voidage_min, 0.01, false, 0.9, false, "drag voidage clamp");
+        r.range("/gas/cfl_factor", g.cfl_factor, 0.0, true, 1.0, false, "CFL safety factor");
         if let Some(dt) = g.time_step_s {
-            r.range("/gas/time_step_s", dt, 0.0, true, self.dem.time_step_s.max(0.0), false, "gas time step (at most the DEM step)");
+            // The gas sub-cycles: its step is a whole number of DEM steps, within the acoustic
+            // CFL limit inside AB3's stability region (cfd::stability).
+            r.range("/gas/time_step_s", dt, 0.0, true, 1.0, false, "gas time step");
+            let dem = self.dem.time_step_s;
+            if dt > 0.0 && dem > 0.0 {
+                let n = dt / dem;
+                if n < 1.0 - 1e-9 || (n - n.round()).abs() > 1e-6 * n {
+                    r.error("/gas/time_step_s", json_num(dt), format!("a whole multiple of the DEM step {dem:e} s, e.g. {:e} s", dem * n.round().max(1.0)), "the gas step must be a whole number of DEM steps");
+                }
+            }
+            if let Some(limit) = crate::cfd::case_stable_time_step(self) {
+                if dt > limit {
+                    r.error("/gas/time_step_s", json_num(dt), format!("<= {limit:.4e} s (acoustic CFL limit with AB3, cfl_factor {})", g.cfl_factor), format!("gas time step {dt:e} s exceeds the largest stable step {limit:.4e} s"));
+                }
+            }
         }
         let rad = self.column.diameter_m / 2.0;
         let gr = &self.grid;

@@ -1,0 +1,248 @@
+//! The right-hand side of eq. (A.1) in finite-volume form: d q/dt per unit volume for every cell,
+//! q = (ρε, ρεu_x, ρεu_y, ρεu_z). Momentum is carried in Cartesian components on the cylindrical
+//! grid (each cell's (U_r, U_θ) is a fixed rotation of them), so fluxes between cells whose
+//! cylindrical bases differ (radial neighbours, the central annulus around the axis) are exact
+//! vector sums, and the cylindrical source terms S of eq. (A.12) come out of the face vector areas
+//! instead of being added as centre values.
+//!
+//! Per face (vector area S from a to b):
+//! - mass flux ṁ = ½(m_a + m_b)·S (central);
+//! - convective momentum flux ṁ·u_f, u_f central in r and θ, QUICK+SMART in z (paper 2.2; PHYSICS.md 6);
+//! - pressure −ε∇p by Green–Gauss with face value ½(p_a + p_b), model A (PHYSICS.md 11);
+//! - a pressure dissipation in the mass flux against the odd–even decoupling of collocated central
+//!   schemes (Rhie–Chow type): ṁ −= (κ/a)ε_f|S|[(p_b − p_a) − ½(∇p_a + ∇p_b)·d], d = x_b − x_a,
+//!   ε_f the mean voidage of the two cells (keeps its damping rate 4κa/dz independent of ε), κ = 0.05.
+//!   It vanishes for any linear pressure field and scales as κ a dz³∂⁴ρ on smooth waves; without it,
+//!   half the acoustic modes of a column with the characteristic outlet are undamped and the
+//!   linearly extrapolated inlet pressure makes some grow (semi-discrete eigenvalues; see the report);
+//! - stress ε∇·τ with τ = μ(∇u + ∇uᵀ) + (L − 2μ/3)(∇·u)I; for constant μ, ∇·τ = μ∇²u + (L + μ/3)∇(∇·u),
+//!   discretised as the compact face flux μ|S|/δ·(u_b − u_a) + (L + μ/3)·½(D_a + D_b)·S (eq. A.5–A.11).
+//! Sources: ρε g (−z) and the interaction force I (eq. A.12).
+
+use super::boundary::ramped_superficial_velocity;
+use super::geometry::FaceGeometry;
+use super::smart::smart_face;
+use super::solver::{GasParams, Outlet};
+
+/// Primitive fields computed from the state before each right-hand side.
+#[derive(Clone, Debug, Default)]
+pub struct Primitives {
+    pub ux: Vec<f64>,
+    pub uy: Vec<f64>,
+    pub uz: Vec<f64>,
+    pub p: Vec<f64>,
+    /// ∇·u per cell (finite volume).
+    pub div: Vec<f64>,
+    /// ∇p per cell (Green–Gauss, Cartesian), the pressure force −ε∇p of the momentum equation.
+    pub gx: Vec<f64>,
+    pub gy: Vec<f64>,
+    pub gz: Vec<f64>,
+}
+
+impl Primitives {
+    pub fn new(n: usize) -> Primitives {
+        let z = vec![0.0; n];
+        Primitives { ux: z.clone(), uy: z.clone(), uz: z.clone(), p: z.clone(), div: z.clone(), gx: z.clone(), gy: z.clone(), gz: z }
+    }
+}
+
+/// Everything the right-hand side reads besides the state.
+pub struct RhsInput<'a> {
+    pub geo: &'a FaceGeometry,
+    pub params: &'a GasParams,
+    pub per: usize,
+    pub nz: usize,
+    pub dz: f64,
+    pub eps: &'a [f64],
+    /// Interaction force per unit volume, cylindrical (r, θ, z) in each cell's basis.
+    pub force: &'a [[f64; 3]],
+    pub time: f64,
+}
+
+impl RhsInput<'_> {
+    /// Interstitial inlet velocity U(t)/ε_inlet and the inlet mass flux per area factor U(t).
+    fn inlet(&self) -> (f64, f64) {
+        let p = self.params;
+        let u = ramped_superficial_velocity(p.superficial_velocity, p.ramp_time, self.time);
+        (u / p.inlet_voidage, u)
+    }
+}
+
+/// Fill the primitive fields of one layer from the state.
+pub fn primitives_layer(inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64]) {
+    let a2 = inp.params.sound_speed * inp.params.sound_speed;
+    let base = k * inp.per;
+    for c in 0..inp.per {
+        let s = q[base + c];
+        let inv = 1.0 / s[0];
+        ux[c] = s[1] * inv;
+        uy[c] = s[2] * inv;
+        uz[c] = s[3] * inv;
+        // Isothermal gas p = ρa², ρ = (ρε)/ε (PHYSICS.md 8).
+        p[c] = a2 * s[0] / inp.eps[base + c];
+    }
+}
+
+/// Coefficient κ of the pressure dissipation in the mass flux (module comment).
+pub const PRESSURE_DISSIPATION: f64 = 0.05;
+
+/// Pressure on the inlet face: the ghost layer below holds the density of layer 0 extrapolated
+/// hydrostatically, ρ_g = ρ₀·exp(g dz/a²), and the face takes the mean (p₀ + p_g)/2.
+#[inline]
+pub fn inlet_face_pressure(p0: f64, gravity: f64, dz: f64, a2: f64) -> f64 {
+    0.5 * p0 * (1.0 + (gravity * dz / a2).exp())
+}
+
+/// Pressure on the top face: a shut top extrapolates hydrostatically as the inlet does; the
+/// characteristic outlet extrapolates linearly from the two top layers.
+#[inline]
+pub fn top_face_pressure(outlet: Outlet, p_top: f64, p_below: f64, gravity: f64, dz: f64, a2: f64) -> f64 {
+    match outlet {
+        Outlet::Wall => 0.5 * p_top * (1.0 + (-gravity * dz / a2).exp()),
+        Outlet::Characteristic => 1.5 * p_top - 0.5 * p_below,
+    }
+}
+
+/// ∇·u and ∇p of one layer's cells by Green–Gauss: (1/V) Σ φ_f S with face means; the tube wall
+/// takes the cell's own values (u·n = 0, p_f = p_c); the ends as in the functions above (the inlet
+/// face velocity U/ε_in, a shut top 0, the outlet zero-gradient).
+#[allow(clippy::too_many_arguments)]
+pub fn gradients_layer(inp: &RhsInput, pr: &Primitives, k: usize, div: &mut [f64], gx: &mut [f64], gy: &mut [f64], gz: &mut [f64]) {
+    let (per, base, geo, par) = (inp.per, k * inp.per, inp.geo, inp.params);
+    let a2 = par.sound_speed * par.sound_speed;
+    for c in 0..per {
+        div[c] = 0.0;
+        gx[c] = 0.0;
+        gy[c] = 0.0;
+    }
+    for f in &geo.faces {
+        let (la, lb) = (f.a as usize, f.b as usize);
+        let (a, b) = (base + la, base + lb);
+        let flux = 0.5 * ((pr.ux[a] + pr.ux[b]) * f.sx + (pr.uy[a] + pr.uy[b]) * f.sy);
+        div[la] += flux;
+        div[lb] -= flux;
+        // (p_f − p_c)·S_out is ½(p_b − p_a)·S for both cells.
+        let dp = 0.5 * (pr.p[b] - pr.p[a]);
+        gx[la] += dp * f.sx;
+        gy[la] += dp * f.sy;
+        gx[lb] += dp * f.sx;
+        gy[lb] += dp * f.sy;
+    }
+    let (w_in, _) = inp.inlet();
+    let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
+    for c in 0..per {
+        let i = base + c;
+        let (w_bot, p_bot) = if k == 0 { (w_in, inlet_face_pressure(pr.p[i], par.gravity, inp.dz, a2)) } else { (0.5 * (pr.uz[i - per] + pr.uz[i]), 0.5 * (pr.p[i - per] + pr.p[i])) };
+        let (w_top, p_top) = if k + 1 < inp.nz {
+            (0.5 * (pr.uz[i] + pr.uz[i + per]), 0.5 * (pr.p[i] + pr.p[i + per]))
+        } else {
+            let p_below = if k > 0 { pr.p[i - per] } else { pr.p[i] };
+            let w = if par.outlet == Outlet::Wall { 0.0 } else { pr.uz[i] };
+            (w, top_face_pressure(par.outlet, pr.p[i], p_below, par.gravity, inp.dz, a2))
+        };
+        div[c] = (div[c] + (w_top - w_bot) * az) * inv_v;
+        gx[c] *= inv_v;
+        gy[c] *= inv_v;
+        gz[c] = (p_top - p_bot) * az * inv_v;
+    }
+}
+
+/// Fluxes across the axial face between cell `lo` (layer kl) and the cell above it: the convective
+/// flux upward [ṁ, ṁu_x, ṁu_y, ṁu_z] and the viscous force on `lo`.
+#[inline]
+fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: usize) -> ([f64; 4], [f64; 3]) {
+    let (per, geo, par) = (inp.per, inp.geo, inp.params);
+    let hi = lo + per;
+    let az = geo.area_z;
+    let diss = PRESSURE_DISSIPATION / par.sound_speed * 0.5 * (inp.eps[lo] + inp.eps[hi]) * az * ((pr.p[hi] - pr.p[lo]) - 0.5 * (pr.gz[lo] + pr.gz[hi]) * inp.dz);
+    let mflux = 0.5 * (q[lo][3] + q[hi][3]) * az - diss;
+    // Upwind cell C, its upwind U (None at the ends: first-order upwind) and downwind D.
+    let (c, u, d) = if mflux >= 0.0 { (lo, if kl >= 1 { Some(lo - per) } else { None }, hi) } else { (hi, if kl + 2 < inp.nz { Some(hi + per) } else { None }, lo) };
+    let face = |v: &[f64]| match u {
+        Some(u) => smart_face(v[u], v[c], v[d]),
+        None => v[c],
+    };
+    let conv = [mflux, mflux * face(&pr.ux), mflux * face(&pr.uy), mflux * face(&pr.uz)];
+    let m = par.viscosity * az / inp.dz;
+    let lam = (par.bulk_viscosity + par.viscosity / 3.0) * 0.5 * (pr.div[lo] + pr.div[hi]) * az;
+    let visc = [m * (pr.ux[hi] - pr.ux[lo]), m * (pr.uy[hi] - pr.uy[lo]), m * (pr.uz[hi] - pr.uz[lo]) + lam];
+    (conv, visc)
+}
+
+/// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long).
+pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize, out: &mut [[f64; 4]]) {
+    let (per, geo, par) = (inp.per, inp.geo, inp.params);
+    let base = k * per;
+    if k + 1 == inp.nz && par.outlet == Outlet::Characteristic && inp.nz > 1 {
+        // The outlet layer follows eq. (5)–(7) instead of the fluxes (solver.rs).
+        out.iter_mut().for_each(|r| *r = [0.0; 4]);
+        return;
+    }
+    // Sources: interaction force (cylindrical → Cartesian), gravity ρεg, pressure −ε∇p.
+    for c in 0..per {
+        let i = base + c;
+        let f = inp.force[i];
+        let (fx, fy) = geo.to_cartesian(c, f[0], f[1]);
+        let e = inp.eps[i];
+        out[c] = [0.0, fx - e * pr.gx[i], fy - e * pr.gy[i], f[2] - par.gravity * q[i][0] - e * pr.gz[i]];
+    }
+    let inv_v = 1.0 / geo.volume;
+    let lam_coef = par.bulk_viscosity + par.viscosity / 3.0;
+    let kappa_a = PRESSURE_DISSIPATION / par.sound_speed;
+    // Horizontal faces (central in r and θ).
+    for f in &geo.faces {
+        let (la, lb) = (f.a as usize, f.b as usize);
+        let (a, b) = (base + la, base + lb);
+        let diss = kappa_a * 0.5 * (inp.eps[a] + inp.eps[b]) * f.s_abs * ((pr.p[b] - pr.p[a]) - 0.5 * ((pr.gx[a] + pr.gx[b]) * f.dx + (pr.gy[a] + pr.gy[b]) * f.dy));
+        let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) - diss;
+        let h = 0.5 * mflux * inv_v;
+        let conv = [mflux * inv_v, h * (pr.ux[a] + pr.ux[b]), h * (pr.uy[a] + pr.uy[b]), h * (pr.uz[a] + pr.uz[b])];
+        let m = par.viscosity * f.area_over_delta * inv_v;
+        let lam = lam_coef * 0.5 * (pr.div[a] + pr.div[b]) * inv_v;
+        let v = [m * (pr.ux[b] - pr.ux[a]) + lam * f.sx, m * (pr.uy[b] - pr.uy[a]) + lam * f.sy, m * (pr.uz[b] - pr.uz[a])];
+        let (ea, eb) = (inp.eps[a], inp.eps[b]);
+        let ra = &mut out[la];
+        ra[0] -= conv[0];
+        for n in 0..3 {
+            ra[n + 1] += ea * v[n] - conv[n + 1];
+        }
+        let rb = &mut out[lb];
+        rb[0] += conv[0];
+        for n in 0..3 {
+            rb[n + 1] += conv[n + 1] - eb * v[n];
+        }
+    }
+    // Axial faces: bottom and top of this layer (each computed identically by both layers).
+    let (w_in, u_in) = inp.inlet();
+    let a2 = par.sound_speed * par.sound_speed;
+    for c in 0..per {
+        let i = base + c;
+        let e = inp.eps[i] * inv_v;
+        let r = &mut out[c];
+        if k == 0 {
+            // Inlet: ṁ = ρ_f·U(t)·A_z with the face density of the hydrostatic ghost, momentum
+            // flux ṁ·U(t)/ε_in (vertical only), no viscous flux.
+            let rho_f = inlet_face_pressure(pr.p[i], par.gravity, inp.dz, a2) / a2;
+            let m_in = rho_f * u_in * geo.area_z;
+            r[0] += m_in * inv_v;
+            r[3] += m_in * w_in * inv_v;
+        } else {
+            let (conv, visc) = axial_face(inp, q, pr, k - 1, i - per);
+            for n in 0..4 {
+                r[n] += conv[n] * inv_v;
+            }
+            for n in 0..3 {
+                r[n + 1] -= e * visc[n];
+            }
+        }
+        if k + 1 < inp.nz {
+            let (conv, visc) = axial_face(inp, q, pr, k, i);
+            for n in 0..4 {
+                r[n] -= conv[n] * inv_v;
+            }
+            for n in 0..3 {
+                r[n + 1] += e * visc[n];
+            }
+        }
+    }
+}

@@ -1,0 +1,398 @@
+//! `GasSolver`: state, time stepping (Heun → AB2 → AB3, PHYSICS.md 7) and the public API the
+//! coupled simulation calls. Boundary and axis decisions are documented in cfd/mod.rs.
+
+use super::ab3::{ab2_weights, ab3_weights};
+use super::boundary::outlet_density_change;
+use super::geometry::FaceGeometry;
+use super::rhs::{gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives, RhsInput};
+use super::stability::cell_stable_dt;
+use crate::case::Case;
+use crate::grid::CylGrid;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Top boundary of the gas.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
+pub enum Outlet {
+    /// Characteristic outlet of the paper's eq. (5)–(7) (PHYSICS.md 9), optional relaxation σ.
+    Characteristic,
+    /// A shut top: full-slip wall (tests: closed column, fully reflecting end).
+    Wall,
+}
+
+/// Gas parameters in SI units, taken from the case's `gas` section.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct GasParams {
+    pub sound_speed: f64,
+    pub viscosity: f64,
+    pub bulk_viscosity: f64,
+    pub gravity: f64,
+    pub superficial_velocity: f64,
+    pub ramp_time: f64,
+    pub inlet_voidage: f64,
+    pub outlet_relaxation: f64,
+    pub outlet_pressure: f64,
+    pub cfl_factor: f64,
+    pub outlet: Outlet,
+}
+
+/// What the grid is rebuilt from after a checkpoint.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct GridSpec {
+    radius: f64,
+    height: f64,
+    dr: f64,
+    dz: f64,
+    n0: usize,
+}
+
+/// The complete serialisable state (checkpoints).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct State {
+    grid: GridSpec,
+    params: GasParams,
+    time: f64,
+    steps: u64,
+    /// Conserved quantities per cell: ρε, ρεu_x, ρεu_y, ρεu_z (Cartesian; see rhs.rs).
+    q: Vec<[f64; 4]>,
+    eps: Vec<f64>,
+    force: Vec<[f64; 3]>,
+    /// Right-hand sides of earlier steps (ring; `head` the newest) and the steps between them.
+    hist: [Vec<[f64; 4]>; 3],
+    hist_h: [f64; 2],
+    hist_len: usize,
+    head: usize,
+}
+
+/// The volume-averaged compressible gas (paper section 2.2 and Appendix A).
+#[derive(Clone, Debug)]
+pub struct GasSolver {
+    st: State,
+    grid: CylGrid,
+    geo: FaceGeometry,
+    prim: Primitives,
+    q_old: Vec<[f64; 4]>,
+    stage: Vec<[f64; 4]>,
+    parallel: bool,
+}
+
+/// Below this many cells the layers are processed on one thread (rayon's overhead dominates; see
+/// docs/BENCHMARKS.md "Gas solver").
+const PARALLEL_MIN_CELLS: usize = 20_000;
+
+impl GasSolver {
+    /// Gas at rest, hydrostatic about `outlet_pressure_pa` at z = height, ε = 1 until set.
+    pub fn new(case: &Case, grid: CylGrid) -> GasSolver {
+        let g = case.gas.clone().unwrap_or_default();
+        let params = GasParams {
+            sound_speed: g.sound_speed_m_s(),
+            viscosity: g.viscosity_pa_s,
+            bulk_viscosity: g.bulk_viscosity_pa_s,
+            gravity: case.gravity_m_s2,
+            superficial_velocity: g.superficial_velocity_m_s,
+            ramp_time: g.ramp_time_s,
+            inlet_voidage: g.inlet_voidage,
+            outlet_relaxation: g.outlet_relaxation,
+            outlet_pressure: g.outlet_pressure_pa,
+            cfl_factor: g.cfl_factor,
+            outlet: Outlet::Characteristic,
+        };
+        let n = grid.num_cells();
+        let spec = GridSpec { radius: grid.radius, height: grid.height, dr: grid.dr, dz: grid.dz, n0: grid.n0 };
+        let st = State { grid: spec, params, time: 0.0, steps: 0, q: vec![[0.0; 4]; n], eps: vec![1.0; n], force: vec![[0.0; 3]; n], hist: [vec![[0.0; 4]; n], vec![[0.0; 4]; n], vec![[0.0; 4]; n]], hist_h: [0.0; 2], hist_len: 0, head: 0 };
+        let mut s = GasSolver::from_state(st, grid);
+        for c in 0..n {
+            let rho = s.hydrostatic_density(c);
+            s.st.q[c] = [rho, 0.0, 0.0, 0.0];
+        }
+        s
+    }
+
+    fn from_state(st: State, grid: CylGrid) -> GasSolver {
+        let n = grid.num_cells();
+        let geo = FaceGeometry::new(&grid);
+        GasSolver { st, geo, prim: Primitives::new(n), q_old: vec![[0.0; 4]; n], stage: vec![[0.0; 4]; n], parallel: n >= PARALLEL_MIN_CELLS, grid }
+    }
+
+    /// ρ(z) = (p_out/a²)·exp(g(H − z)/a²) at the centre of cell c (PHYSICS.md 8).
+    pub fn hydrostatic_density(&self, cell: usize) -> f64 {
+        let p = &self.st.params;
+        let a2 = p.sound_speed * p.sound_speed;
+        let z = self.grid.centre_xyz(cell)[2];
+        p.outlet_pressure / a2 * (p.gravity * (self.grid.height - z) / a2).exp()
+    }
+
+    pub fn grid(&self) -> &CylGrid {
+        &self.grid
+    }
+    pub fn params(&self) -> &GasParams {
+        &self.st.params
+    }
+    /// Change the top boundary (default: characteristic outlet).
+    pub fn set_outlet(&mut self, outlet: Outlet) {
+        self.st.params.outlet = outlet;
+    }
+    /// Process layers on rayon's pool (default: on for grids of 20,000 cells or more).
+    pub fn set_parallel(&mut self, on: bool) {
+        self.parallel = on;
+    }
+    pub fn time(&self) -> f64 {
+        self.st.time
+    }
+    /// Completed steps.
+    pub fn steps(&self) -> u64 {
+        self.st.steps
+    }
+
+    /// Initial voidage: set ε and keep each cell's density ρ (the gas mass changes). Use once,
+    /// before the run starts; during a run use `set_voidage`.
+    pub fn set_initial_voidage(&mut self, eps: &[f64]) {
+        assert_eq!(eps.len(), self.st.eps.len(), "one voidage per cell");
+        for (c, &e) in eps.iter().enumerate() {
+            let f = e / self.st.eps[c];
+            self.st.q[c].iter_mut().for_each(|v| *v *= f);
+            self.st.eps[c] = e;
+        }
+    }
+
+    /// Voidage per cell. The gas mass ρεV of each cell is held: ρ = (ρε)/ε_new, so displaced gas
+    /// shows as a pressure rise.
+    pub fn set_voidage(&mut self, eps: &[f64]) {
+        assert_eq!(eps.len(), self.st.eps.len(), "one voidage per cell");
+        self.st.eps.copy_from_slice(eps);
+    }
+    pub fn voidage(&self) -> &[f64] {
+        &self.st.eps
+    }
+    /// Interaction force per unit volume on the gas, cylindrical (r, θ, z) in each cell's basis.
+    pub fn interaction_force_mut(&mut self) -> &mut [[f64; 3]] {
+        &mut self.st.force
+    }
+
+    /// Set one cell's density ρ and interstitial velocity (U_r, U_θ, U_z) at its current voidage.
+    pub fn set_cell(&mut self, cell: usize, rho: f64, u_cyl: [f64; 3]) {
+        let c = cell % self.grid.cells_per_layer();
+        let (ux, uy) = self.geo.to_cartesian(c, u_cyl[0], u_cyl[1]);
+        let re = rho * self.st.eps[cell];
+        self.st.q[cell] = [re, re * ux, re * uy, re * u_cyl[2]];
+    }
+
+    /// ρ (not ρε).
+    pub fn density(&self, cell: usize) -> f64 {
+        self.st.q[cell][0] / self.st.eps[cell]
+    }
+    /// Interstitial velocity (U_r, U_θ, U_z) in the cell's cylindrical basis.
+    pub fn velocity_cyl(&self, cell: usize) -> [f64; 3] {
+        let s = self.st.q[cell];
+        let (ur, ut) = self.geo.to_cylindrical(cell % self.grid.cells_per_layer(), s[1] / s[0], s[2] / s[0]);
+        [ur, ut, s[3] / s[0]]
+    }
+    /// Interstitial Cartesian velocity (u_x, u_y, u_z).
+    pub fn velocity_xyz(&self, cell: usize) -> [f64; 3] {
+        let s = self.st.q[cell];
+        [s[1] / s[0], s[2] / s[0], s[3] / s[0]]
+    }
+    /// Velocity on the axis in layer k: the central annulus' velocities converted to x, y and
+    /// averaged (paper section 2.2).
+    pub fn axis_velocity(&self, k: usize) -> [f64; 3] {
+        let n0 = self.grid.n0;
+        let mut v = [0.0; 3];
+        for j in 0..n0 {
+            let u = self.velocity_xyz(self.grid.index(0, j, k));
+            (0..3).for_each(|d| v[d] += u[d] / n0 as f64);
+        }
+        v
+    }
+    /// Absolute pressure p = ρa² per cell.
+    pub fn pressure(&self) -> Vec<f64> {
+        (0..self.st.q.len()).map(|c| self.pressure_at(c)).collect()
+    }
+    #[inline]
+    fn pressure_at(&self, cell: usize) -> f64 {
+        let a = self.st.params.sound_speed;
+        a * a * self.st.q[cell][0] / self.st.eps[cell]
+    }
+    /// Σ ρεV.
+    pub fn total_mass(&self) -> f64 {
+        self.st.q.iter().map(|s| s[0]).sum::<f64>() * self.geo.volume
+    }
+
+    /// ∇p at the cell centre as (∂p/∂r, (1/r)∂p/∂θ, ∂p/∂z): the Green–Gauss gradient of the
+    /// momentum equation (rhs.rs `gradients_layer`: wall faces p_c, the ends as documented there).
+    pub fn pressure_gradient_cyl(&self, cell: usize) -> [f64; 3] {
+        let per = self.grid.cells_per_layer();
+        let (c, k) = (cell % per, cell / per);
+        let base = k * per;
+        let pc = self.pressure_at(cell);
+        let (mut gx, mut gy) = (0.0, 0.0);
+        for n in self.geo.neighbours(c) {
+            let dp = 0.5 * (self.pressure_at(base + n.c as usize) - pc);
+            gx += dp * n.sx;
+            gy += dp * n.sy;
+        }
+        let (nz, par) = (self.grid.nz, &self.st.params);
+        let a2 = par.sound_speed * par.sound_speed;
+        let p_bot = if k == 0 { inlet_face_pressure(pc, par.gravity, self.grid.dz, a2) } else { 0.5 * (pc + self.pressure_at(cell - per)) };
+        let p_top = if k + 1 < nz {
+            0.5 * (pc + self.pressure_at(cell + per))
+        } else {
+            let p_below = if k > 0 { self.pressure_at(cell - per) } else { pc };
+            top_face_pressure(par.outlet, pc, p_below, par.gravity, self.grid.dz, a2)
+        };
+        let gz = (p_top - p_bot) / self.grid.dz;
+        let v = self.geo.volume;
+        let (gr, gt) = self.geo.to_cylindrical(c, gx / v, gy / v);
+        [gr, gt, gz]
+    }
+
+    /// Largest stable step for the current state (acoustic CFL inside AB3's region; stability.rs).
+    pub fn stable_dt(&self) -> f64 {
+        let p = &self.st.params;
+        let g = &self.grid;
+        let nu_num = 4.0 / 3.0 * p.viscosity + p.bulk_viscosity;
+        let mut dt = f64::INFINITY;
+        for (c, s) in self.st.q.iter().enumerate() {
+            let inv = 1.0 / s[0];
+            let uh = (s[1] * s[1] + s[2] * s[2]).sqrt() * inv;
+            let nu = nu_num * self.st.eps[c] * inv;
+            dt = dt.min(cell_stable_dt(uh, (s[3] * inv).abs(), p.sound_speed, nu, g.dr, g.dz, g.n0, self.geo.max_laplacian_factor, p.cfl_factor));
+        }
+        dt
+    }
+
+    /// NaN/Inf or non-positive density anywhere, with the cell (i, j, k) and the quantity.
+    pub fn check_finite(&self) -> Result<(), String> {
+        const NAMES: [&str; 4] = ["ρε", "ρεu_x", "ρεu_y", "ρεu_z"];
+        for (c, s) in self.st.q.iter().enumerate() {
+            let (i, j, k) = self.grid.ijk(c);
+            for (n, v) in s.iter().enumerate() {
+                if !v.is_finite() {
+                    return Err(format!("gas {} = {v} in cell (i={i}, j={j}, k={k}) at t = {:.6e} s", NAMES[n], self.st.time));
+                }
+            }
+            if s[0] <= 0.0 {
+                return Err(format!("gas density ρε = {} ≤ 0 in cell (i={i}, j={j}, k={k}) at t = {:.6e} s", s[0], self.st.time));
+            }
+            let e = self.st.eps[c];
+            if !(e > 0.0 && e.is_finite()) {
+                return Err(format!("voidage ε = {e} in cell (i={i}, j={j}, k={k}) at t = {:.6e} s", self.st.time));
+            }
+        }
+        Ok(())
+    }
+
+    /// Advance by dt: Heun for the first step, then AB2, then AB3 with variable-step weights.
+    pub fn step(&mut self, dt: f64) {
+        let t = self.st.time;
+        self.q_old.copy_from_slice(&self.st.q);
+        let newest = (self.st.head + 1) % 3;
+        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
+        self.rhs_into(t, &mut f_new);
+        let hl = self.st.hist_len;
+        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        {
+            let (q, q0) = (&mut self.st.q, &self.q_old);
+            match hl {
+                0 => {
+                    // Heun predictor.
+                    q.iter_mut().zip(q0).zip(&f_new).for_each(|((y, y0), f)| (0..4).for_each(|n| y[n] = y0[n] + dt * f[n]));
+                }
+                1 => {
+                    let b = ab2_weights(dt, h1);
+                    let f1 = &self.st.hist[self.st.head];
+                    q.iter_mut().zip(q0).zip(f_new.iter().zip(f1)).for_each(|((y, y0), (f, g))| (0..4).for_each(|n| y[n] = y0[n] + dt * (b[0] * f[n] + b[1] * g[n])));
+                }
+                _ => {
+                    let b = ab3_weights(dt, h1, h2);
+                    let (f1, f2) = (&self.st.hist[self.st.head], &self.st.hist[(self.st.head + 2) % 3]);
+                    q.iter_mut().zip(q0).zip(f_new.iter().zip(f1.iter().zip(f2))).for_each(|((y, y0), (f, (g, h)))| (0..4).for_each(|n| y[n] = y0[n] + dt * (b[0] * f[n] + b[1] * g[n] + b[2] * h[n])));
+                }
+            }
+        }
+        self.apply_outlet(dt);
+        if hl == 0 {
+            // Heun corrector: y1 = y0 + h/2 (f(y0) + f(y*)).
+            let mut stage = std::mem::take(&mut self.stage);
+            self.rhs_into(t + dt, &mut stage);
+            self.st.q.iter_mut().zip(&self.q_old).zip(f_new.iter().zip(&stage)).for_each(|((y, y0), (f, g))| (0..4).for_each(|n| y[n] = y0[n] + 0.5 * dt * (f[n] + g[n])));
+            self.stage = stage;
+            self.apply_outlet(dt);
+        }
+        self.st.hist[newest] = f_new;
+        self.st.head = newest;
+        self.st.hist_h = [dt, h1];
+        self.st.hist_len = (hl + 1).min(3);
+        self.st.time = t + dt;
+        self.st.steps += 1;
+    }
+
+    /// The outlet layer (paper eq. 5–7, PHYSICS.md 9): its momentum changes copy the layer below
+    /// (as ρU, i.e. divided by that layer's ε), and Δρ = [Δ(ρU_z) − Δt K a(ρ − ρ_∞)]/(U_z + a).
+    fn apply_outlet(&mut self, dt: f64) {
+        let nz = self.grid.nz;
+        if self.st.params.outlet != Outlet::Characteristic || nz < 2 {
+            return;
+        }
+        let per = self.grid.cells_per_layer();
+        let p = &self.st.params;
+        let a = p.sound_speed;
+        // Relaxation target: the hydrostatic density at the outlet cell centre.
+        let rho_inf = p.outlet_pressure / (a * a) * (p.gravity * 0.5 * self.grid.dz / (a * a)).exp();
+        for c in 0..per {
+            let (top, below) = ((nz - 1) * per + c, (nz - 2) * per + c);
+            let (eb, et) = (self.st.eps[below], self.st.eps[top]);
+            let old = self.q_old[top];
+            let mut new = old;
+            for n in 1..4 {
+                new[n] = old[n] + et * (self.st.q[below][n] - self.q_old[below][n]) / eb;
+            }
+            let d_rho_uz = (new[3] - old[3]) / et;
+            let d_rho = outlet_density_change(d_rho_uz, old[3] / old[0], a, old[0] / et, rho_inf, p.outlet_relaxation, self.grid.height, dt);
+            new[0] = old[0] + et * d_rho;
+            self.st.q[top] = new;
+        }
+    }
+
+    /// Right-hand side of the current state `self.st.q` at time t into `out`.
+    fn rhs_into(&mut self, t: f64, out: &mut [[f64; 4]]) {
+        let per = self.grid.cells_per_layer();
+        let inp = RhsInput { geo: &self.geo, params: &self.st.params, per, nz: self.grid.nz, dz: self.grid.dz, eps: &self.st.eps, force: &self.st.force, time: t };
+        let q = &self.st.q;
+        let pr = &mut self.prim;
+        if self.parallel {
+            pr.ux.par_chunks_mut(per).zip(pr.uy.par_chunks_mut(per)).zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per))).enumerate().for_each(|(k, ((ux, uy), (uz, p)))| primitives_layer(&inp, q, k, ux, uy, uz, p));
+            let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
+            let prr = &*pr;
+            div.par_chunks_mut(per).zip(gx.par_chunks_mut(per)).zip(gy.par_chunks_mut(per).zip(gz.par_chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
+            (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
+            let pr = &*pr;
+            out.par_chunks_mut(per).enumerate().for_each(|(k, o)| residual_layer(&inp, q, pr, k, o));
+        } else {
+            pr.ux.chunks_mut(per).zip(pr.uy.chunks_mut(per)).zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per))).enumerate().for_each(|(k, ((ux, uy), (uz, p)))| primitives_layer(&inp, q, k, ux, uy, uz, p));
+            let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
+            let prr = &*pr;
+            div.chunks_mut(per).zip(gx.chunks_mut(per)).zip(gy.chunks_mut(per).zip(gz.chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
+            (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
+            let pr = &*pr;
+            out.chunks_mut(per).enumerate().for_each(|(k, o)| residual_layer(&inp, q, pr, k, o));
+        }
+    }
+}
+
+impl Serialize for GasSolver {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.st.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for GasSolver {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let st = State::deserialize(d)?;
+        let g = &st.grid;
+        let grid = CylGrid::new(g.radius, g.height, g.dr, g.dz, g.n0);
+        if grid.num_cells() != st.q.len() {
+            return Err(serde::de::Error::custom("gas state does not match its grid"));
+        }
+        Ok(GasSolver::from_state(st, grid))
+    }
+}

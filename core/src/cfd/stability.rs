@@ -1,0 +1,42 @@
+//! The largest stable gas step: the acoustic CFL limit inside AB3's stability region
+//! (PHYSICS.md 7: |λh| ≤ 0.7236 on the imaginary axis, ≥ −6/11 on the negative real axis).
+//!
+//! Convective/acoustic spectral radius of a cell (central fluxes; Blazek's estimate ½Σ(|u·n|+a)|S|/V):
+//!   λ_c = (|u_h| + a)·(1 + n0/π)/dr + (|u_z| + a)/dz     (geometry::horizontal_inverse_spacing)
+//! Viscous spectral radius of the compact Laplacian with ν = (4μ/3 + L)/ρ:
+//!   λ_v = 2ν·max_c Σ_f (|S_f|/δ_f)/V
+//! and dt = cfl·1/(λ_c/0.7236 + λ_v/(6/11)), the min over cells.
+
+use super::ab3::{AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
+use super::geometry::{horizontal_inverse_spacing, FaceGeometry};
+use crate::case::Case;
+use crate::grid::CylGrid;
+
+/// Stable step of one cell state (see the module comment).
+#[allow(clippy::too_many_arguments)]
+#[inline]
+pub fn cell_stable_dt(u_h: f64, u_z: f64, a: f64, nu: f64, dr: f64, dz: f64, n0: usize, laplacian_factor: f64, cfl: f64) -> f64 {
+    let lam_c = (u_h + a) * horizontal_inverse_spacing(dr, n0) + (u_z + a) / dz;
+    let lam_v = 2.0 * nu * laplacian_factor;
+    cfl / (lam_c / AB3_IMAGINARY_LIMIT + lam_v / AB3_REAL_LIMIT)
+}
+
+/// The stable gas step a case's inlet flow allows before it runs: gas at the outlet density,
+/// speed U/ε_inlet in every direction. `None` when the grid or gas parameters are unusable
+/// (validation reports those separately).
+pub fn case_stable_time_step(case: &Case) -> Option<f64> {
+    let g = case.gas.as_ref()?;
+    let (radius, dr, dz, n0) = (case.column.diameter_m / 2.0, case.grid.dr_m, case.grid_dz_m(), case.grid.n0);
+    let ok = |x: f64| x.is_finite() && x > 0.0;
+    if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && radius / dr < 1e4 && n0 >= 1 && n0 <= 64) {
+        return None;
+    }
+    let (a, rho) = (g.sound_speed_m_s(), g.outlet_density_kg_m3());
+    if !(ok(a) && ok(rho) && ok(g.inlet_voidage) && ok(g.cfl_factor)) {
+        return None;
+    }
+    let geo = FaceGeometry::new(&CylGrid::new(radius, 2.0 * dz, dr, dz, n0));
+    let u = g.superficial_velocity_m_s.abs() / g.inlet_voidage;
+    let nu = (4.0 / 3.0 * g.viscosity_pa_s + g.bulk_viscosity_pa_s) / rho;
+    Some(cell_stable_dt(u, u, a, nu, dr, dz, n0, geo.max_laplacian_factor, g.cfl_factor))
+}

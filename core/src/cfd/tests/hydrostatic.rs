@@ -1,0 +1,33 @@
+//! A quiescent column relaxes to ρ(z) = ρ0·exp(−g z / a²) (PHYSICS.md 8).
+
+use super::support::{layer_mean, solver};
+use crate::case::Gas;
+
+#[test]
+fn quiescent_column_relaxes_to_the_isothermal_hydrostatic_profile() {
+    // Closed bottom (inlet velocity 0), characteristic outlet with relaxation; start from a uniform
+    // density, so the column is out of balance by ρ g H/a² and must find the profile itself.
+    let gas = Gas { superficial_velocity_m_s: 0.0, outlet_relaxation: 0.25, ..Default::default() };
+    let (nz, dz) = (40, 0.0025);
+    let mut s = solver(gas, 9.81, 1, 0.005, nz, dz);
+    let rho_top = s.params().outlet_pressure / s.params().sound_speed.powi(2);
+    for c in 0..s.grid().num_cells() {
+        s.set_cell(c, rho_top, [0.0; 3]);
+    }
+    let dt = s.stable_dt();
+    let a2 = s.params().sound_speed.powi(2);
+    for _ in 0..20_000 {
+        s.step(dt);
+    }
+    let rho = |k: usize| layer_mean(&s, k, |c| s.density(c));
+    let z = |k: usize| (k as f64 + 0.5) * dz;
+    let variation = rho(0) - rho(nz - 1);
+    let want_variation = rho(nz - 1) * ((9.81 * (z(nz - 1) - z(0)) / a2).exp() - 1.0);
+    for k in 0..nz {
+        let want = rho(nz - 1) * (9.81 * (z(nz - 1) - z(k)) / a2).exp();
+        assert!((rho(k) - want).abs() < 0.02 * want_variation, "layer {k}: ρ = {} want {want} (variation {variation:e})", rho(k));
+    }
+    let umax = (0..s.grid().num_cells()).map(|c| s.velocity_cyl(c).iter().fold(0.0f64, |m, v| m.max(v.abs()))).fold(0.0, f64::max);
+    // The initial imbalance drives velocities of order (ρgH/a²/ρ)·a ≈ 3e-3 m/s.
+    assert!(umax < 1e-5, "velocities have not decayed: {umax:e} m/s");
+}

@@ -1,0 +1,8 @@
+//! Physics tests of the gas solver against analytic values.
+
+mod acoustics;
+mod conservation;
+mod hydrostatic;
+mod porous_zone;
+mod support;
+mod validation;
