@@ -1,12 +1,14 @@
 //! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|all>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
+mod cfd;
 mod dem;
 mod voidage;
 
 fn main() {
     let what = std::env::args().nth(1).unwrap_or_else(|| "all".into());
     match what.as_str() {
+        "cfd" => cfd::run(),
         "dem" => dem::run(),
         "voidage" => voidage::run(),
         other => {
