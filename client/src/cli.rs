@@ -47,8 +47,9 @@ enum Verb {
     /// Download results into a folder.
     Fetch {
         id: String,
-        #[arg(long, default_value = "fluidbed-out")]
-        out: PathBuf,
+        /// Output folder (default ./fluidbed-out/<job id>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
         /// Per-snapshot encodings: npy, vtk, json (comma separated).
         #[arg(long, default_value = "npy,vtk")]
         formats: String,
@@ -219,6 +220,7 @@ async fn dispatch(cli: Cli) -> i32 {
             Err(e) => api_fail(e, j),
         },
         Verb::Fetch { id, out, formats } => {
+            let out = out.unwrap_or_else(|| PathBuf::from("fluidbed-out").join(&id));
             let f = match Formats::parse(&formats) {
                 Ok(f) => f,
                 Err(m) => return fail(exit::USAGE, &m),
