@@ -31,3 +31,16 @@ fn quiescent_column_relaxes_to_the_isothermal_hydrostatic_profile() {
     // The initial imbalance drives velocities of order (ρgH/a²/ρ)·a ≈ 3e-3 m/s.
     assert!(umax < 1e-5, "velocities have not decayed: {umax:e} m/s");
 }
+
+#[test]
+fn pressure_gradient_of_the_initial_state_is_minus_rho_g_everywhere() {
+    // The initial state is hydrostatic, so ∇p = (0, 0, −ρg) at every cell centre, the end cells
+    // included (inlet ghost extrapolated hydrostatically, outlet face linearly).
+    let s = solver(Gas::default(), 9.81, 3, 0.004, 6, 0.004);
+    for c in 0..s.grid().num_cells() {
+        let g = s.pressure_gradient_cyl(c);
+        let want = -s.density(c) * 9.81;
+        assert!((g[2] / want - 1.0).abs() < 1e-4, "cell {c}: ∂p/∂z = {} want {want}", g[2]);
+        assert!(g[0].abs() < 1e-8 && g[1].abs() < 1e-8, "cell {c}: horizontal gradient {g:?}");
+    }
+}
