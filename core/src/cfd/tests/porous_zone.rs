@@ -54,5 +54,6 @@ fn porous_zone_pressure_drop_matches_model_a_beetstra() {
     let rho = layer_mean(&s, (k1 + k2) / 2, |c| s.density(c));
     let (e, phi) = (0.4, 0.6);
     let want = 18.0 * mu * phi * beetstra_f(e, rho * u0 * d / mu) * u0 / (e * d * d);
+    eprintln!("porous zone: Δp/L = {dpdl:.1} Pa/m, analytic {want:.1} Pa/m");
     assert!((dpdl / want - 1.0).abs() < 0.03, "Δp/L = {dpdl} Pa/m, analytic {want} Pa/m");
 }
