@@ -1,6 +1,7 @@
 //! Bed generation: random sequential (non-overlapping) insertion in the tube from a seeded
 //! ChaCha RNG, pouring under gravity and settling until the kinetic energy is small; cached on
-//! disk keyed by a hash of everything that determines the result.
+//! disk keyed by a hash of everything that determines the result (the thread count does not:
+//! the pour uses a fixed work split).
 //!
 //! For a settled height H we pour more than enough particles (count from an estimated packing
 //! fraction of 0.60, plus 15 %), settle, then remove every particle whose top is above H
@@ -25,6 +26,8 @@ const POUR_SPEED: f64 = 2e-3;
 const RELAX_SPEED: f64 = 1e-3;
 /// Give up after this much simulated time in one phase.
 const MAX_PHASE_TIME_S: f64 = 5.0;
+/// Fixed work split while pouring, so the bed does not depend on the thread count.
+const BED_CHUNKS: usize = 8;
 /// Bump when the algorithm changes (invalidates cached beds).
 const ALGORITHM_VERSION: u32 = 1;
 
@@ -79,6 +82,7 @@ pub fn generate(
     let mut p = DemParams::new(&pour_case);
     p.lid = false;
     p.extra_damping = 5.0;
+    p.work_chunks = BED_CHUNKS;
     let mut sys = DemSystem::with_params(p, x, vec![[0.0; 3]; n]);
     settle(&mut sys, POUR_SPEED, observe)?;
     let (mut x, mut v) = (sys.positions().to_vec(), sys.velocities().to_vec());
@@ -95,6 +99,7 @@ pub fn generate(
     // Final relaxation with the case's own parameters.
     let mut p = DemParams::new(case);
     p.lid = false;
+    p.work_chunks = BED_CHUNKS;
     let mut sys = DemSystem::with_params(p, x, v);
     settle(&mut sys, RELAX_SPEED, observe)?;
     Ok((sys.positions().to_vec(), sys.velocities().to_vec()))

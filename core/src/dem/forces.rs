@@ -1,10 +1,11 @@
-//! The two parallel passes of a DEM step, both deterministic for any thread count:
-//! 1. pair pass: every listed pair once (half list), force on the first particle into a per-pair
-//!    array, blocks of particles in parallel (each block owns its contiguous slice of pairs);
-//! 2. particle pass: gather each particle's pair forces in a fixed order (its own row, then its
-//!    transpose row), add walls, gravity and the external force, and (fused) advance it by AB.
+//! The two parallel passes of a DEM step, bit-reproducible for a given work split (chunk count):
+//! 1. pair pass: every listed pair once (half list), contiguous particle chunks in parallel, each
+//!    adding the pair forces on i and j into its own buffer (no atomics, no races);
+//! 2. particle pass: sum the chunk buffers for each particle in chunk order, add walls, gravity
+//!    and the external force, and (fused) advance it by AB3.
 
 use super::contact::{contact_force, ContactLaw, V3};
+use super::pair_batch::{Batch, CAP};
 use super::integrator::ab_update;
 use super::neighbors::{NeighborList, BLOCK};
 use super::DemParams;
@@ -45,83 +46,123 @@ impl Stats {
     }
 }
 
-/// Split `s` into consecutive pieces at the pair offsets of each particle block.
-fn split_blocks<'a, T>(mut s: &'a mut [T], offsets: &[u32], nblocks: usize, n: usize) -> Vec<&'a mut [T]> {
-    let mut out = Vec::with_capacity(nblocks);
-    for b in 0..nblocks {
-        let (a, e) = (offsets[b * BLOCK] as usize, offsets[((b + 1) * BLOCK).min(n)] as usize);
-        if s.is_empty() {
-            out.push(&mut [][..]);
-            continue;
-        }
-        let (head, tail) = s.split_at_mut(e - a);
-        out.push(head);
-        s = tail;
-    }
-    out
+/// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
+/// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
+/// partner index of the chunk. The chunks depend only on the list and the thread count, and the
+/// buffers are summed in chunk order, so a run is bit-reproducible for a given thread count.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// Per chunk: a, b, e.
+    pub bounds: Vec<[usize; 3]>,
+    /// Start of each chunk's buffer in `f` and `t`.
+    pub start: Vec<usize>,
+    pub f: Vec<V3>,
+    pub t: Vec<V3>,
 }
 
-/// Pass 1: force on particle i of every listed pair (i, j) into `pf`, n × F_t into `pc`.
+impl Scratch {
+    /// Plan `chunks` chunks (fewer for small systems) over the list.
+    pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
+        let nc = chunks.clamp(1, n.div_ceil(512).max(1));
+        let mut bounds = Vec::with_capacity(nc);
+        let mut start = Vec::with_capacity(nc + 1);
+        start.push(0);
+        for c in 0..nc {
+            let (a, b) = (c * n / nc, (c + 1) * n / nc);
+            let mut e = b;
+            for i in a..b {
+                let (k0, k1) = (nl.offsets[i] as usize, nl.offsets[i + 1] as usize);
+                if k1 > k0 {
+                    e = e.max(nl.nbr[k1 - 1] as usize + 1);
+                }
+            }
+            bounds.push([a, b, e]);
+            start.push(start[c] + e - a);
+        }
+        let len = start[nc];
+        Scratch { bounds, start, f: vec![[0.0; 3]; len], t: vec![[0.0; 3]; len] }
+    }
+}
+
+/// Pass 1: all listed pairs, forces and torques accumulated into the chunk buffers.
 pub fn pair_pass<const FR: bool>(
     p: &DemParams,
     x: &[V3],
     v: &[V3],
     w: &[V3],
     nl: &mut NeighborList,
-    pf: &mut [V3],
-    pc: &mut [V3],
+    sc: &mut Scratch,
 ) -> Stats {
-    let n = x.len();
-    let nb = n.div_ceil(BLOCK);
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
-    let shear = split_blocks(&mut nl.shear, offsets, nb, n);
-    let pfs = split_blocks(pf, offsets, nb, n);
-    let pcs = split_blocks(pc, offsets, nb, n);
+    let mut work = Vec::with_capacity(sc.bounds.len());
+    let (mut sh_rest, mut f_rest, mut t_rest) = (&mut nl.shear[..], &mut sc.f[..], &mut sc.t[..]);
+    for &[a, b, e] in &sc.bounds {
+        let (sh, r1) = sh_rest.split_at_mut((offsets[b] - offsets[a]) as usize);
+        let (f, r2) = f_rest.split_at_mut(e - a);
+        let (t, r3) = t_rest.split_at_mut(e - a);
+        (sh_rest, f_rest, t_rest) = (r1, r2, r3);
+        work.push((a, b, sh, f, t));
+    }
     let (d, r) = (2.0 * p.radius, p.radius);
     let d2 = d * d;
     let (law, h) = (&p.pair, p.dt);
-    shear
-        .into_par_iter()
-        .zip(pfs)
-        .zip(pcs)
-        .enumerate()
-        .map(|(b, ((sh, pfb), pcb))| {
+    work.into_par_iter()
+        .map(|(a, b, sh, fb, tb)| {
+            fb.fill([0.0; 3]);
+            if FR {
+                tb.fill([0.0; 3]);
+            }
             let mut st = Stats::ZERO;
-            let base = offsets[b * BLOCK] as usize;
-            for i in b * BLOCK..((b + 1) * BLOCK).min(n) {
-                let (xi, vi) = (x[i], v[i]);
-                let wi = if FR { w[i] } else { [0.0; 3] };
-                for k in offsets[i] as usize..offsets[i + 1] as usize {
-                    let kk = k - base;
-                    let j = nbr[k] as usize;
-                    let dx = [x[j][0] - xi[0], x[j][1] - xi[1], x[j][2] - xi[2]];
+            let base = offsets[a] as usize;
+            let mut batch = Batch::new();
+            let flush = |batch: &mut Batch, sh: &mut [V3], fb: &mut [V3], tb: &mut [V3], st: &mut Stats| {
+                let (ov, ex) = batch.evaluate::<FR>(law, r, h, v, w, sh, base);
+                st.overlap = st.overlap.max(ov);
+                st.coulomb_excess = st.coulomb_excess.max(ex);
+                for l in 0..batch.m {
+                    let (ii, jj) = (batch.i[l] as usize - a, batch.j[l] as usize - a);
+                    for q in 0..3 {
+                        fb[ii][q] += batch.f[q][l];
+                        fb[jj][q] -= batch.f[q][l];
+                    }
+                    if FR {
+                        // Both partners feel R n × F_t (contact points ±R n, forces ±F_t).
+                        for q in 0..3 {
+                            tb[ii][q] += batch.c[q][l];
+                            tb[jj][q] += batch.c[q][l];
+                        }
+                    }
+                }
+                batch.m = 0;
+            };
+            let mut m = 0; // lanes filled (kept in a register; batch.m is set before a flush)
+            for i in a..b {
+                let xi = x[i];
+                let row = &nbr[offsets[i] as usize..offsets[i + 1] as usize];
+                for (kr, &j) in row.iter().enumerate() {
+                    let j = j as usize;
+                    let xj = x[j];
+                    let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                     let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+                    let k = offsets[i] as usize + kr;
                     if r2 >= d2 {
-                        pfb[kk] = [0.0; 3];
                         if FR {
-                            sh[kk] = [0.0; 3];
-                            pcb[kk] = [0.0; 3];
+                            sh[k - base] = [0.0; 3];
                         }
                         continue;
                     }
-                    let dist = r2.sqrt();
-                    let inv = 1.0 / dist;
-                    let nrm = [dx[0] * inv, dx[1] * inv, dx[2] * inv];
-                    let delta = d - dist;
-                    let vrel = [vi[0] - v[j][0], vi[1] - v[j][1], vi[2] - v[j][2]];
-                    let ws = if FR { [r * (wi[0] + w[j][0]), r * (wi[1] + w[j][1]), r * (wi[2] + w[j][2])] } else { [0.0; 3] };
-                    let mut s = if FR { sh[kk] } else { [0.0; 3] };
-                    let cf = contact_force::<FR>(law, delta, nrm, vrel, ws, &mut s, h);
-                    pfb[kk] = cf.f;
-                    if FR {
-                        sh[kk] = s;
-                        pcb[kk] = cf.c;
-                        st.coulomb_excess = st.coulomb_excess.max(cf.excess);
+                    batch.set(m, k, i, j, dx, r2);
+                    m += 1;
+                    if m == CAP {
+                        batch.m = m;
+                        flush(&mut batch, sh, fb, tb, &mut st);
+                        m = 0;
                     }
-                    st.overlap = st.overlap.max(delta);
                 }
             }
+            batch.m = m;
+            flush(&mut batch, sh, fb, tb, &mut st);
             st
         })
         .reduce(|| Stats::ZERO, Stats::max)
@@ -154,30 +195,23 @@ fn wall_contact<const FR: bool>(
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub fn accel<const FR: bool>(
-    p: &DemParams, i: usize, xi: V3, vi: V3, wi: V3, wall: &mut [V3; 3], ext: V3, nl: &NeighborList, pf: &[V3],
-    pc: &[V3], st: &mut Stats,
+    p: &DemParams, i: usize, xi: V3, vi: V3, wi: V3, wall: &mut [V3; 3], ext: V3, sc: &Scratch, st: &mut Stats,
 ) -> (V3, V3) {
     let mut f = ext;
     let mut t = [0.0; 3];
-    for k in nl.offsets[i] as usize..nl.offsets[i + 1] as usize {
-        let q = pf[k];
-        f = [f[0] + q[0], f[1] + q[1], f[2] + q[2]];
-        if FR {
-            let c = pc[k];
-            t = [t[0] + c[0], t[1] + c[1], t[2] + c[2]];
-        }
-    }
-    for &k in &nl.rev_pairs[nl.rev_offsets[i] as usize..nl.rev_offsets[i + 1] as usize] {
-        let q = pf[k as usize];
-        f = [f[0] - q[0], f[1] - q[1], f[2] - q[2]];
-        if FR {
-            let c = pc[k as usize];
-            t = [t[0] + c[0], t[1] + c[1], t[2] + c[2]];
+    for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
+        if a <= i && i < e {
+            let k = sc.start[c] + i - a;
+            let q = sc.f[k];
+            f = [f[0] + q[0], f[1] + q[1], f[2] + q[2]];
+            if FR {
+                let c = sc.t[k];
+                t = [t[0] + c[0], t[1] + c[1], t[2] + c[2]];
+            }
         }
     }
     let r = p.radius;
     if FR {
-        // Both partners of a pair feel R n × F_t (contact points ±R n, forces ±F_t).
         t = [r * t[0], r * t[1], r * t[2]];
     }
     let (law, h) = (&p.wall, p.dt);
@@ -212,8 +246,7 @@ pub fn accel<const FR: bool>(
 /// Pass 2 for start-up: accelerations only, into `a` and `alpha`.
 #[allow(clippy::too_many_arguments)]
 pub fn accel_pass<const FR: bool>(
-    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], past: &mut [Past], ext: &[V3], nl: &NeighborList, pf: &[V3],
-    pc: &[V3], a: &mut [V3], alpha: &mut [V3],
+    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], past: &mut [Past], ext: &[V3], sc: &Scratch, a: &mut [V3], alpha: &mut [V3],
 ) -> Stats {
     past.par_chunks_mut(BLOCK)
         .zip(a.par_chunks_mut(BLOCK))
@@ -223,7 +256,7 @@ pub fn accel_pass<const FR: bool>(
             let mut st = Stats::ZERO;
             for l in 0..ps.len() {
                 let i = b * BLOCK + l;
-                (ab[l], lb[l]) = accel::<FR>(p, i, x[i], v[i], w[i], &mut ps[l].wall, ext[i], nl, pf, pc, &mut st);
+                (ab[l], lb[l]) = accel::<FR>(p, i, x[i], v[i], w[i], &mut ps[l].wall, ext[i], sc, &mut st);
             }
             st
         })
@@ -234,7 +267,7 @@ pub fn accel_pass<const FR: bool>(
 #[allow(clippy::too_many_arguments)]
 pub fn update_pass<const FR: bool>(
     p: &DemParams, hb: [f64; 3], x: &mut [V3], v: &mut [V3], w: &mut [V3], past: &mut [Past], ext: &[V3],
-    nl: &NeighborList, pf: &[V3], pc: &[V3],
+    sc: &Scratch,
 ) -> Stats {
     x.par_chunks_mut(BLOCK)
         .zip(v.par_chunks_mut(BLOCK))
@@ -247,7 +280,7 @@ pub fn update_pass<const FR: bool>(
                 let i = b * BLOCK + l;
                 let (xi, vi, wi) = (xs[l], vs[l], ws[l]);
                 let q = &mut ps[l];
-                let (a, alpha) = accel::<FR>(p, i, xi, vi, wi, &mut q.wall, ext[i], nl, pf, pc, &mut st);
+                let (a, alpha) = accel::<FR>(p, i, xi, vi, wi, &mut q.wall, ext[i], sc, &mut st);
                 let xn = ab_update(xi, vi, q.v[0], q.v[1], hb);
                 vs[l] = ab_update(vi, a, q.a[0], q.a[1], hb);
                 q.v = [vi, q.v[0]];

@@ -3,6 +3,7 @@
 //! - `contact`: the contact law (PHYSICS.md 2), one kernel for pairs and walls;
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
+//! - `pair_batch`: the same law for batches of particle pairs (the fast path);
 //! - `forces`: the two deterministic parallel passes of a step;
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
@@ -12,6 +13,7 @@ pub mod contact;
 pub mod forces;
 pub mod integrator;
 pub mod neighbors;
+pub mod pair_batch;
 pub mod system;
 
 #[cfg(test)]
@@ -48,6 +50,9 @@ pub struct DemParams {
     pub friction: bool,
     /// Extra viscous damping rate (1/s) on v and ω; used only while pouring a bed, 0 otherwise.
     pub extra_damping: f64,
+    /// Work chunks of the pair pass; 0 = twice the pool's threads. The summation order follows
+    /// the chunks, so a fixed value makes results independent of the thread count.
+    pub work_chunks: usize,
 }
 
 impl DemParams {
@@ -70,6 +75,7 @@ impl DemParams {
             wall: ContactLaw::new(case, r, m),
             friction: case.particles.sliding_friction > 0.0,
             extra_damping: 0.0,
+            work_chunks: 0,
         }
     }
 }

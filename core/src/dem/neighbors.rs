@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// Particles per work block in the parallel passes (fixed, so results do not depend on threads).
 pub const BLOCK: usize = 256;
 
-/// Half neighbour list in CSR form, plus its transpose (pairs where a particle is the second).
+/// Half neighbour list in CSR form.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct NeighborList {
     /// Row i is nbr[offsets[i]..offsets[i+1]], all j > i.
@@ -17,11 +17,6 @@ pub struct NeighborList {
     pub nbr: Vec<u32>,
     /// Tangential displacement ξ of each listed pair (oriented i → j), zero when not touching.
     pub shear: Vec<[f64; 3]>,
-    /// Transpose: pair indices k with nbr[k] == j are rev_pairs[rev_offsets[j]..rev_offsets[j+1]].
-    #[serde(skip)]
-    pub rev_offsets: Vec<u32>,
-    #[serde(skip)]
-    pub rev_pairs: Vec<u32>,
 }
 
 /// Cell order of the particles: the permutation that sorts them by linked cell (stable).
@@ -153,31 +148,10 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList
         }
         nbr.extend_from_slice(&list);
     }
-    let mut nl = NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], ..Default::default() };
-    nl.build_reverse(x.len());
-    nl
+    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total] }
 }
 
 impl NeighborList {
-    /// Transpose of the list (serial, so the order of pairs per particle is fixed).
-    pub fn build_reverse(&mut self, n: usize) {
-        let mut ro = vec![0u32; n + 1];
-        for &j in &self.nbr {
-            ro[j as usize + 1] += 1;
-        }
-        for j in 0..n {
-            ro[j + 1] += ro[j];
-        }
-        let mut fill = ro.clone();
-        let mut rp = vec![0u32; self.nbr.len()];
-        for (k, &j) in self.nbr.iter().enumerate() {
-            rp[fill[j as usize] as usize] = k as u32;
-            fill[j as usize] += 1;
-        }
-        self.rev_offsets = ro;
-        self.rev_pairs = rp;
-    }
-
     /// Carry the non-zero contact history of `old` (whose particles had ids `old_ids`) into this
     /// list (particles with ids `new_ids`), matched by id pair; orientation flips change the sign.
     pub fn carry_history(&mut self, old: &NeighborList, old_ids: &[u32], new_ids: &[u32]) {

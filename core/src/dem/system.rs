@@ -3,7 +3,7 @@
 //! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
 
 use super::contact::V3;
-use super::forces::{accel_pass, pair_pass, update_pass, Past, Stats};
+use super::forces::{accel_pass, pair_pass, update_pass, Past, Scratch, Stats};
 use super::integrator::weights;
 use super::neighbors::{build_list, cell_order, NeighborList};
 use super::DemParams;
@@ -28,11 +28,11 @@ pub struct DemSystem {
     frozen: bool,
     rebuild_due: bool,
     last: (f64, f64),
-    /// Scratch per-pair arrays (force on the first particle, n × F_t), rebuilt every step.
     #[serde(skip)]
-    pf: Vec<V3>,
+    sc_threads: usize,
+    /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
     #[serde(skip)]
-    pc: Vec<V3>,
+    sc: Scratch,
 }
 
 impl DemSystem {
@@ -59,8 +59,8 @@ impl DemSystem {
             frozen: false,
             rebuild_due: false,
             last: (0.0, f64::NEG_INFINITY),
-            pf: Vec::new(),
-            pc: Vec::new(),
+            sc_threads: 0,
+            sc: Scratch::default(),
         };
         s.rebuild();
         s
@@ -163,17 +163,12 @@ impl DemSystem {
     }
 
     fn advance<const FR: bool>(&mut self) {
-        let np = self.nl.nbr.len();
-        if self.pf.len() != np {
-            self.pf = vec![[0.0; 3]; np];
+        let chunks = if self.p.work_chunks > 0 { self.p.work_chunks } else { 2 * rayon::current_num_threads() };
+        if self.sc.bounds.is_empty() || self.sc_threads != chunks {
+            self.sc = Scratch::plan(&self.nl, self.x.len(), chunks);
+            self.sc_threads = chunks;
         }
-        if FR && self.pc.len() != np {
-            self.pc = vec![[0.0; 3]; np];
-        }
-        if self.nl.rev_offsets.len() != self.x.len() + 1 {
-            self.nl.build_reverse(self.x.len()); // after a restore (the transpose is not stored)
-        }
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.pf, &mut self.pc);
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
         let st2 = if self.levels == 0 {
             self.heun::<FR>()
         } else {
@@ -181,7 +176,7 @@ impl DemSystem {
             let b = weights(self.levels);
             let hb = [h * b[0], h * b[1], h * b[2]];
             let (x, v, w, past) = (&mut self.x, &mut self.v, &mut self.w, &mut self.past);
-            let st = update_pass::<FR>(&self.p, hb, x, v, w, past, &self.ext, &self.nl, &self.pf, &self.pc);
+            let st = update_pass::<FR>(&self.p, hb, x, v, w, past, &self.ext, &self.sc);
             self.levels = (self.levels + 1).min(3);
             st
         };
@@ -202,7 +197,7 @@ impl DemSystem {
         let h = self.p.dt;
         let (mut a0, mut l0) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
         let st = accel_pass::<FR>(
-            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.nl, &self.pf, &self.pc, &mut a0, &mut l0,
+            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.sc, &mut a0, &mut l0,
         );
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
         let (shear1, past1) = (self.nl.shear.clone(), self.past.clone());
@@ -212,10 +207,10 @@ impl DemSystem {
             self.v[i] = step(&v0[i], &a0[i], h);
             self.w[i] = step(&w0[i], &l0[i], h);
         }
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.pf, &mut self.pc);
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
         let (mut a1, mut l1) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
         accel_pass::<FR>(
-            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.nl, &self.pf, &self.pc, &mut a1, &mut l1,
+            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.sc, &mut a1, &mut l1,
         );
         self.nl.shear = shear1;
         self.past = past1;
@@ -254,6 +249,7 @@ impl DemSystem {
             nl.carry_history(&self.nl, &old_ids, &self.ids);
         }
         self.nl = nl;
+        self.sc = Scratch::default();
         for (q, x) in self.past.iter_mut().zip(&self.x) {
             q.x_build = *x;
         }

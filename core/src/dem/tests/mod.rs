@@ -1,6 +1,7 @@
 //! DEM tests: each compares with an analytic or published value (PHYSICS.md 2, 7; textbook
 //! mechanics) and stays small enough to run in seconds.
 
+mod batch_kernel;
 mod checkpoint;
 mod energy;
 mod integrator_order;
