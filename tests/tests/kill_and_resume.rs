@@ -17,7 +17,7 @@ async fn final_particles(http: &reqwest::Client, url: &str) -> (usize, Vec<f64>)
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn killed_server_resumes_job_to_the_same_final_state() {
     let http = reqwest::Client::new();
-    let case = lattice_case(8, 4, 0.12, 0.01);
+    let case = lattice_case(8, 4, 0.3, 0.02);
 
     // Uninterrupted reference run.
     let ref_dir = TempDir::new("reference");
