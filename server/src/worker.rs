@@ -54,12 +54,16 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                 .spawn(move || {
                     while !app.stopping() {
                         if let Some(id) = app.queue.pop(Duration::from_millis(200)) {
-                            if let Err(e) = run_job(&app, &id) {
-                                if !app.stopping() {
-                                    eprintln!("fluidbed-server: job {id}: {e:#}");
-                                    let msg = format!("internal error: {e:#}");
-                                    finish(&app, &id, Status::Failed, Some(&msg));
-                                }
+                            // A panic in the solver fails its job, not the worker.
+                            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_job(&app, &id)));
+                            let error = match outcome {
+                                Ok(Ok(())) => None,
+                                Ok(Err(e)) => Some(format!("internal error: {e:#}")),
+                                Err(p) => Some(format!("the solver panicked: {}", panic_text(&*p))),
+                            };
+                            if let Some(msg) = error.filter(|_| !app.stopping()) {
+                                eprintln!("fluidbed-server: job {id}: {msg}");
+                                finish(&app, &id, Status::Failed, Some(&msg));
                             }
                         }
                     }
@@ -67,6 +71,10 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                 .expect("spawn worker thread")
         })
         .collect()
+}
+
+fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
+    p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into())
 }
 
 fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
