@@ -1,12 +1,27 @@
 //! Validation runs: `cargo run --release -p fluidbed-core --example validate -- <name>`.
 //! Each prints its figures and, last, one JSON line {"name","figure","reference","rel_err",...}.
 
+mod bubbling;
+mod common;
+mod fig3;
+mod fluidized;
+mod packed_bed;
+mod plots;
 mod table3;
+
+/// Print the validation's one-line JSON result (the last line, read by the checks).
+fn report(v: serde_json::Value) {
+    println!("{v}");
+}
 
 fn main() {
     let what = std::env::args().nth(1).unwrap_or_default();
     match what.as_str() {
         "table3" => table3::run(),
+        "packed-bed" => report(packed_bed::run(false)),
+        "fluidized" => report(fluidized::run()),
+        "fig3" => report(fig3::run()),
+        "bubbling" => report(bubbling::run()),
         other => {
             eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, fig3 or bubbling");
             std::process::exit(2);

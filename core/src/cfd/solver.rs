@@ -129,6 +129,10 @@ impl GasSolver {
         &self.st.params
     }
     /// Change the top boundary (default: characteristic outlet).
+    /// Set the inlet's superficial velocity (the ramp, if still running, now leads to this value).
+    pub fn set_superficial_velocity(&mut self, u: f64) {
+        self.st.params.superficial_velocity = u;
+    }
     pub fn set_outlet(&mut self, outlet: Outlet) {
         self.st.params.outlet = outlet;
     }

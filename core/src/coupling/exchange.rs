@@ -50,6 +50,7 @@ fn angle_of(x: f64, y: f64) -> (f64, f64) {
 /// Fluid force on every particle (Cartesian, −V_p∇p + drag) into `force_out`, and the interaction
 /// force per unit volume on the gas, I = −Σ drag / V_cell (cylindrical, cell-centre basis), into
 /// `cell_force_out` (overwritten). `d` is the particle diameter; ε is clamped to [eps_min, 1).
+/// Allocates its work arrays: the step loop keeps an `Exchange` instead.
 #[allow(clippy::too_many_arguments)]
 pub fn particle_gas_forces(
     grid: &CylGrid,
@@ -62,41 +63,116 @@ pub fn particle_gas_forces(
     force_out: &mut [[f64; 3]],
     cell_force_out: &mut [[f64; 3]],
 ) {
-    assert_eq!(pos.len(), vel.len());
-    assert_eq!(pos.len(), force_out.len());
-    assert_eq!(cell_force_out.len(), grid.num_cells());
-    // 1. drag on every particle (parallel), kept in force_out for now
-    force_out.par_iter_mut().zip(pos.par_iter().zip(vel.par_iter())).for_each(|(f, (p, v))| {
-        let c = grid.locate(p[0], p[1], p[2]);
-        let (cos, sin) = angle_of(p[0], p[1]);
-        let u = cyl_to_cart(gas.velocity_cyl[c], cos, sin);
-        let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
-        *f = drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, slip);
-    });
-    // 2. the gas loses the drag in the cell of the particle's centre (fixed order: deterministic)
-    for f in cell_force_out.iter_mut() {
-        *f = [0.0; 3];
+    Exchange::new(grid, pos.len()).particle_gas_forces(grid, gas, mu, eps_min, d, pos, vel, force_out, cell_force_out);
+}
+
+/// The exchange's work arrays and per-cell basis angles, allocated once per run.
+pub struct Exchange {
+    /// (cos θ_c, sin θ_c) of each in-layer cell's centre angle.
+    cell_basis: Vec<(f64, f64)>,
+    /// Cell of each particle's centre and its drag (Cartesian), from the parallel pass.
+    cell_of: Vec<u32>,
+    drag: Vec<[f64; 3]>,
+    /// Frozen beds: per cell, particle count and Σcos, Σsin of (θ_p − θ_c) (see `frozen_cell_forces`).
+    frozen: Vec<(f64, f64, f64)>,
+}
+
+impl Exchange {
+    pub fn new(grid: &CylGrid, particles: usize) -> Exchange {
+        let mut cell_basis = Vec::with_capacity(grid.cells_per_layer());
+        for i in 0..grid.nr {
+            for j in 0..grid.cells_in_annulus(i) {
+                let th = grid.centre_polar(i, j).1;
+                cell_basis.push((th.cos(), th.sin()));
+            }
+        }
+        Exchange { cell_basis, cell_of: vec![0; particles], drag: vec![[0.0; 3]; particles], frozen: Vec::new() }
     }
-    let inv_v = 1.0 / grid.cell_volume();
-    for (f, p) in force_out.iter().zip(pos) {
-        let c = grid.locate(p[0], p[1], p[2]);
-        let (i, j, _) = grid.ijk(c);
-        let th = grid.centre_polar(i, j).1;
-        let fc = cart_to_cyl(*f, th.cos(), th.sin());
-        for m in 0..3 {
-            cell_force_out[c][m] -= fc[m] * inv_v;
+
+    /// See the free function `particle_gas_forces`; no allocation.
+    #[allow(clippy::too_many_arguments)]
+    pub fn particle_gas_forces(
+        &mut self,
+        grid: &CylGrid,
+        gas: &GasAtCells,
+        mu: f64,
+        eps_min: f64,
+        d: f64,
+        pos: &[[f64; 3]],
+        vel: &[[f64; 3]],
+        force_out: &mut [[f64; 3]],
+        cell_force_out: &mut [[f64; 3]],
+    ) {
+        assert_eq!(pos.len(), vel.len());
+        assert_eq!(pos.len(), force_out.len());
+        assert_eq!(cell_force_out.len(), grid.num_cells());
+        self.cell_of.resize(pos.len(), 0);
+        self.drag.resize(pos.len(), [0.0; 3]);
+        let vp = PI * d * d * d / 6.0;
+        // 1. per particle (parallel): its cell, the drag, and the total force −V_p∇p + drag, with
+        //    the gas vectors turned to Cartesian at the particle's own angle (paper section 2.3)
+        (force_out, &mut self.drag[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
+            |((f, dr, co), (p, v))| {
+                let c = grid.locate(p[0], p[1], p[2]);
+                let (cos, sin) = angle_of(p[0], p[1]);
+                let u = cyl_to_cart(gas.velocity_cyl[c], cos, sin);
+                let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
+                *dr = drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, slip);
+                let g = cyl_to_cart(gas.grad_p_cyl[c], cos, sin);
+                *f = [dr[0] - vp * g[0], dr[1] - vp * g[1], dr[2] - vp * g[2]];
+                *co = c as u32;
+            },
+        );
+        // 2. the gas loses the drag in the cell of the particle's centre, in that cell's basis
+        //    (serial, fixed order: deterministic)
+        cell_force_out.iter_mut().for_each(|f| *f = [0.0; 3]);
+        let inv_v = 1.0 / grid.cell_volume();
+        let per = grid.cells_per_layer();
+        for (dr, &c) in self.drag.iter().zip(&self.cell_of) {
+            let c = c as usize;
+            let (cos, sin) = self.cell_basis[c % per];
+            let fc = cart_to_cyl(*dr, cos, sin);
+            for m in 0..3 {
+                cell_force_out[c][m] -= fc[m] * inv_v;
+            }
         }
     }
-    // 3. add the pressure-gradient force −V_p∇p (model A)
-    let vp = PI * d * d * d / 6.0;
-    force_out.par_iter_mut().zip(pos.par_iter()).for_each(|(f, p)| {
-        let c = grid.locate(p[0], p[1], p[2]);
-        let (cos, sin) = angle_of(p[0], p[1]);
-        let g = cyl_to_cart(gas.grad_p_cyl[c], cos, sin);
-        for m in 0..3 {
-            f[m] -= vp * g[m];
+
+    /// Remember a frozen bed (particles at rest for the whole run) for `frozen_cell_forces`.
+    pub fn freeze(&mut self, grid: &CylGrid, pos: &[[f64; 3]]) {
+        self.frozen = vec![(0.0, 0.0, 0.0); grid.num_cells()];
+        let per = grid.cells_per_layer();
+        for p in pos {
+            let c = grid.locate(p[0], p[1], p[2]);
+            let (cp, sp) = angle_of(p[0], p[1]);
+            let (cc, sc) = self.cell_basis[c % per];
+            let e = &mut self.frozen[c];
+            // cos and sin of θ_p − θ_c
+            *e = (e.0 + 1.0, e.1 + cp * cc + sp * sc, e.2 + sp * cc - cp * sc);
         }
-    });
+    }
+
+    /// The gas side of the exchange for a frozen bed, in O(cells): every particle of a cell is at
+    /// rest and sees the same gas state, so its drag differs only by the rotation θ_p − θ_c of the
+    /// cell's velocity; summed, I_c = −D(|u_c|)·(C u_r − S u_θ, S u_r + C u_θ, N u_z)/V_cell with
+    /// N, C = Σcos, S = Σsin over the cell's particles. Equal to `particle_gas_forces`' gas side
+    /// to round-off; the particles' own forces are not needed (they do not move).
+    pub fn frozen_cell_forces(&self, grid: &CylGrid, gas: &GasAtCells, mu: f64, eps_min: f64, d: f64, cell_force_out: &mut [[f64; 3]]) {
+        assert_eq!(self.frozen.len(), grid.num_cells(), "freeze() first");
+        let inv_v = 1.0 / grid.cell_volume();
+        for (c, (f, &(n, cs, sn))) in cell_force_out.iter_mut().zip(&self.frozen).enumerate() {
+            if n == 0.0 {
+                *f = [0.0; 3];
+                continue;
+            }
+            let u = gas.velocity_cyl[c];
+            // drag_force is linear in the slip at fixed |slip|: its coefficient from a unit call
+            let k = drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, u);
+            let w = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
+            let coef = if w > 0.0 { (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt() / w } else { drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, [0.0, 0.0, 1.0])[2] };
+            *f = [-coef * (cs * u[0] - sn * u[1]) * inv_v, -coef * (sn * u[0] + cs * u[1]) * inv_v, -coef * n * u[2] * inv_v];
+        }
+    }
 }
 
 #[cfg(test)]
@@ -199,6 +275,36 @@ mod tests {
         }
         for q in 0..3 {
             assert!((drag[q] + gas_side[q]).abs() < 1e-12 * scale * m as f64, "{q}: {} vs {}", drag[q], gas_side[q]);
+        }
+    }
+
+    #[test]
+    fn frozen_shortcut_equals_the_particle_sum() {
+        let g = grid();
+        let n = g.num_cells();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let vel_c: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
+        let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
+        let grad = vec![[0.0, 0.0, -5000.0]; n];
+        let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
+        let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
+        let pos: Vec<[f64; 3]> = (0..3000)
+            .map(|_| {
+                let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
+            })
+            .collect();
+        let vel = vec![[0.0; 3]; pos.len()];
+        let (mut f, mut full, mut fast) = (vec![[0.0; 3]; pos.len()], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let mut ex = Exchange::new(&g, pos.len());
+        ex.particle_gas_forces(&g, &gas, 1.8e-5, 0.1, 1.2e-3, &pos, &vel, &mut f, &mut full);
+        ex.freeze(&g, &pos);
+        ex.frozen_cell_forces(&g, &gas, 1.8e-5, 0.1, 1.2e-3, &mut fast);
+        let scale = full.iter().flat_map(|v| v.iter()).fold(0.0f64, |m, x| m.max(x.abs()));
+        for c in 0..n {
+            for m in 0..3 {
+                assert!((full[c][m] - fast[c][m]).abs() <= 1e-12 * scale, "cell {c}: {:?} vs {:?}", full[c], fast[c]);
+            }
         }
     }
 }

@@ -1,4 +1,254 @@
-//! The simulation: state, plan, step loop, watchdog, snapshots and checkpoints.
+//! The simulation: owns the state (particles, gas, coupling buffers), follows the plan, runs the
+//! step loop with its watchdog, and produces snapshots and checkpoints.
 
+mod coupled;
+pub mod plan;
 pub mod snapshot;
+mod watchdog;
+
+pub use plan::Plan;
 pub use snapshot::{GridInfo, ParticleSnapshot, Snapshot, SnapshotSink};
+
+use crate::case::{Case, Field};
+use crate::cfd::GasSolver;
+use crate::coupling::{build_voidage, VoidageMethod};
+use crate::dem::DemSystem;
+use crate::grid::CylGrid;
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimError {
+    /// The case cannot be built (bed generation failed, ...).
+    Build(String),
+    /// The watchdog stopped the run: what, where, when, and which parameter to change.
+    Unstable(String),
+    /// A checkpoint could not be read.
+    Checkpoint(String),
+}
+
+impl std::fmt::Display for SimError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SimError::Build(m) => write!(f, "cannot build the simulation: {m}"),
+            SimError::Unstable(m) => write!(f, "run stopped by the stability watchdog: {m}"),
+            SimError::Checkpoint(m) => write!(f, "bad checkpoint: {m}"),
+        }
+    }
+}
+impl std::error::Error for SimError {}
+
+/// Everything that evolves; what a checkpoint holds.
+#[derive(Serialize, Deserialize)]
+struct State {
+    /// The case travels as JSON text (its tagged enums are not bincode-friendly).
+    #[serde(with = "case_as_json")]
+    case: Case,
+    plan: Plan,
+    steps: u64,
+    snapshots_taken: u64,
+    dem: DemSystem,
+    gas: Option<GasSolver>,
+}
+
+/// Wall time spent per stage (seconds), for progress reports and benchmarks.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct StageTimers {
+    pub dem: f64,
+    pub gas: f64,
+    pub voidage: f64,
+    pub exchange: f64,
+}
+
+pub struct Simulation {
+    st: State,
+    timers: StageTimers,
+    grid: CylGrid,
+    voidage: Box<dyn VoidageMethod>,
+    buf: coupled::Buffers,
+    steps_per_snapshot: u64,
+    end_steps: u64,
+}
+
+impl Simulation {
+    /// Build a run: the settled bed (poured, or loaded from `cache_dir`), the gas, the plan.
+    pub fn new(case: Case, cache_dir: Option<&Path>) -> Result<Simulation, SimError> {
+        let (pos, vel) = crate::dem::build_bed(&case, cache_dir).map_err(SimError::Build)?;
+        let mut dem = DemSystem::new(&case, pos, vel);
+        dem.set_frozen(case.dem.frozen);
+        let grid = fluid_grid(&case);
+        let gas = case.gas.as_ref().map(|_| GasSolver::new(&case, grid.clone()));
+        let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt()));
+        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas };
+        let mut sim = Simulation::assemble(st, grid);
+        sim.initial_voidage();
+        Ok(sim)
+    }
+
+    fn assemble(st: State, grid: CylGrid) -> Simulation {
+        let voidage = build_voidage(&st.case, &grid);
+        let dt = st.case.dem.time_step_s;
+        let steps_per_snapshot = ((st.case.outputs.snapshot_interval_s / dt).round() as u64).max(1);
+        let end_steps = ((st.case.end_time_s / dt).round() as u64).max(1);
+        let buf = coupled::Buffers::new(&grid, st.dem.len());
+        Simulation { st, timers: StageTimers::default(), grid, voidage, buf, steps_per_snapshot, end_steps }
+    }
+
+    pub fn case(&self) -> &Case {
+        &self.st.case
+    }
+    pub fn plan(&self) -> &Plan {
+        &self.st.plan
+    }
+    pub fn grid(&self) -> &CylGrid {
+        &self.grid
+    }
+    pub fn dem(&self) -> &DemSystem {
+        &self.st.dem
+    }
+    pub fn gas(&self) -> Option<&GasSolver> {
+        self.st.gas.as_ref()
+    }
+    pub fn steps(&self) -> u64 {
+        self.st.steps
+    }
+    pub fn timers(&self) -> &StageTimers {
+        &self.timers
+    }
+    /// Change the set superficial velocity from now on (no new ramp); used by the U_mf sweep.
+    pub fn set_superficial_velocity(&mut self, u: f64) {
+        if let Some(g) = self.st.case.gas.as_mut() {
+            g.superficial_velocity_m_s = u;
+        }
+        if let Some(gas) = self.st.gas.as_mut() {
+            gas.set_superficial_velocity(u);
+        }
+    }
+    pub fn time(&self) -> f64 {
+        self.st.steps as f64 * self.st.case.dem.time_step_s
+    }
+    pub fn end_time(&self) -> f64 {
+        self.end_steps as f64 * self.st.case.dem.time_step_s
+    }
+    pub fn is_finished(&self) -> bool {
+        self.st.steps >= self.end_steps && self.st.snapshots_taken > self.last_snapshot_index()
+    }
+    fn last_snapshot_index(&self) -> u64 {
+        self.end_steps.div_ceil(self.steps_per_snapshot)
+    }
+
+    /// Run at most `max_steps` steps; returns Some(snapshot) when a snapshot time is reached.
+    /// Snapshot 0 is the initial state, returned by the first call before any step.
+    pub fn advance(&mut self, max_steps: u64) -> Result<Option<Snapshot>, SimError> {
+        if self.st.snapshots_taken == 0 {
+            return Ok(Some(self.take_snapshot()));
+        }
+        for _ in 0..max_steps {
+            if self.st.steps >= self.end_steps {
+                break;
+            }
+            self.step()?;
+            if self.st.steps % self.steps_per_snapshot == 0 || self.st.steps == self.end_steps {
+                return Ok(Some(self.take_snapshot()));
+            }
+        }
+        Ok(None)
+    }
+
+    /// Run to the end, handing every snapshot to `sink`.
+    pub fn run(&mut self, sink: &mut dyn SnapshotSink) -> Result<(), SimError> {
+        while !self.is_finished() {
+            if let Some(s) = self.advance(u64::MAX)? {
+                sink.snapshot(&s);
+            }
+        }
+        Ok(())
+    }
+
+    /// The complete state; `restore` continues bit-identically.
+    pub fn checkpoint(&self) -> Vec<u8> {
+        bincode::serialize(&self.st).expect("state serialises")
+    }
+
+    pub fn restore(bytes: &[u8]) -> Result<Simulation, SimError> {
+        let st: State = bincode::deserialize(bytes).map_err(|e| SimError::Checkpoint(e.to_string()))?;
+        let grid = fluid_grid(&st.case);
+        let mut sim = Simulation::assemble(st, grid);
+        sim.refresh_voidage_field();
+        Ok(sim)
+    }
+
+    fn take_snapshot(&mut self) -> Snapshot {
+        if self.st.plan.voidage_field && !self.st.plan.coupling {
+            self.refresh_voidage_field();
+        }
+        let fields = self.st.case.outputs.fields.clone();
+        let want = |f: Field| fields.contains(&f);
+        let voidage = (self.st.plan.voidage_field && want(Field::Voidage)).then(|| self.buf.voidage.clone());
+        let (mut pressure, mut dp, mut layer_dp, mut vel) = (None, None, None, None);
+        if let Some(g) = &self.st.gas {
+            let p = g.pressure();
+            let layers = crate::analysis::layer_means(&self.grid, &p);
+            dp = Some(crate::analysis::bed_pressure_drop(&layers));
+            layer_dp = Some(layers.windows(2).map(|w| w[0] - w[1]).collect());
+            if want(Field::Pressure) {
+                pressure = Some(p);
+            }
+            if want(Field::GasVelocity) {
+                vel = Some((0..self.grid.num_cells()).map(|c| g.velocity_cyl(c)).collect());
+            }
+        }
+        let particles = self.st.plan.particle_field.then(|| self.particle_snapshot());
+        let s = Snapshot {
+            index: self.st.snapshots_taken,
+            time_s: self.time(),
+            step: self.st.steps,
+            grid: GridInfo::of(&self.grid),
+            voidage,
+            pressure_pa: pressure,
+            gas_velocity_m_s: vel,
+            pressure_drop_pa: dp,
+            layer_pressure_drop_pa: layer_dp,
+            particles,
+        };
+        self.st.snapshots_taken += 1;
+        s
+    }
+
+    /// Particle state in the original order.
+    pub fn particle_snapshot(&self) -> ParticleSnapshot {
+        let d = &self.st.dem;
+        let n = d.len();
+        let mut pos = vec![[0.0; 3]; n];
+        let mut vel = vec![[0.0; 3]; n];
+        for (k, &id) in d.ids().iter().enumerate() {
+            pos[id as usize] = d.positions()[k];
+            vel[id as usize] = d.velocities()[k];
+        }
+        ParticleSnapshot { radius_m: d.radius(), positions_m: pos, velocities_m_s: vel }
+    }
+
+    fn refresh_voidage_field(&mut self) {
+        coupled::compute_voidage(&self.grid, self.voidage.as_mut(), &self.st.dem, &mut self.buf);
+    }
+}
+
+mod case_as_json {
+    use crate::case::Case;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+    pub fn serialize<S: Serializer>(c: &Case, s: S) -> Result<S::Ok, S::Error> {
+        serde_json::to_string(c).map_err(serde::ser::Error::custom)?.serialize(s)
+    }
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Case, D::Error> {
+        let text = String::deserialize(d)?;
+        serde_json::from_str(&text).map_err(serde::de::Error::custom)
+    }
+}
+
+/// The fluid grid of a case (also used for voidage maps of DEM-only runs).
+pub fn fluid_grid(case: &Case) -> CylGrid {
+    CylGrid::new(case.column.diameter_m / 2.0, case.column.height_m, case.grid.dr_m, case.grid_dz_m(), case.grid.n0)
+}
+
+#[cfg(test)]
+mod tests;

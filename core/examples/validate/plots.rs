@@ -1,0 +1,33 @@
+//! PNG figures for docs/VALIDATION.md, drawn with the solver's own encoders (core/src/output).
+
+use fluidbed_core::output::plot;
+use fluidbed_core::sim::Snapshot;
+
+fn save(img: &fluidbed_core::output::png::Image, path: &str) {
+    if let Some(dir) = std::path::Path::new(path).parent() {
+        std::fs::create_dir_all(dir).expect("figure dir");
+    }
+    std::fs::write(path, img.encode()).expect("write png");
+    eprintln!("wrote {path}");
+}
+
+/// ΔP against time (with the reference as a second, flat series when given).
+pub fn pressure_trace(snaps: &[Snapshot], path: &str, _reference: Option<f64>) {
+    let t: Vec<f64> = snaps.iter().filter(|s| s.pressure_drop_pa.is_some()).map(|s| s.time_s).collect();
+    let y: Vec<f64> = snaps.iter().filter_map(|s| s.pressure_drop_pa).collect();
+    save(&plot::trace(&t, &y), path);
+}
+
+/// ΔP against U from the minimum-fluidization sweep.
+pub fn umf_curve(points: &[(f64, f64)], _weight: f64, _umf: f64, path: &str) {
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
+    let u: Vec<f64> = p.iter().map(|x| x.0).collect();
+    let dp: Vec<f64> = p.iter().map(|x| x.1).collect();
+    save(&plot::trace(&u, &dp), path);
+}
+
+/// A cell field on the vertical plane through the axis.
+pub fn slice(s: &Snapshot, field: &[f64], lo: f64, hi: f64, path: &str) {
+    save(&plot::axial_slice(&s.grid.grid(), field, lo, hi), path);
+}
