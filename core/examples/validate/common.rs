@@ -89,3 +89,15 @@ pub fn bed_top_m(sim: &Simulation) -> f64 {
     z.sort_by(|a, b| a.partial_cmp(b).unwrap());
     z[(z.len() as f64 * 0.99) as usize] + sim.dem().radius()
 }
+
+/// Run a case file to its end and report where the wall time went.
+pub fn timed_case(path: &str) -> serde_json::Value {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    let case = Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0;
+    let t0 = Instant::now();
+    let (sim, snaps) = run_case(case, path);
+    let t = sim.timers();
+    serde_json::json!({"name": "case", "case": path, "particles": sim.dem().len(), "steps": sim.steps(), "snapshots": snaps.len(),
+        "wall_s": t0.elapsed().as_secs_f64(), "dem_s": t.dem, "gas_s": t.gas, "voidage_s": t.voidage, "exchange_s": t.exchange,
+        "last_dp_pa": snaps.last().and_then(|s| s.pressure_drop_pa)})
+}

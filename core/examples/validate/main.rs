@@ -22,6 +22,8 @@ fn main() {
         "fluidized" => report(fluidized::run()),
         "fig3" => report(fig3::run()),
         "bubbling" => report(bubbling::run()),
+        // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
+        "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),
         other => {
             eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, fig3 or bubbling");
             std::process::exit(2);
