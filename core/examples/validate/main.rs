@@ -8,6 +8,7 @@ mod fluidized;
 mod packed_bed;
 mod plots;
 mod table3;
+mod umf;
 
 /// Print the validation's one-line JSON result (the last line, read by the checks).
 fn report(v: serde_json::Value) {
@@ -21,6 +22,7 @@ fn main() {
         "packed-bed" => report(packed_bed::run(false)),
         "fluidized" => report(fluidized::run()),
         "fig3" => report(fig3::run()),
+        "umf" => report(umf::run()),
         "bubbling" => report(bubbling::run()),
         // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
         "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),
