@@ -74,7 +74,14 @@ pub fn run() {
     if cores > 1 {
         counts.push(cores);
     }
-    let (warm, timed) = (1000u64, 2000u64);
+    // Profiling overrides, e.g. FLUIDBED_DEM_BENCH="0,200,1" for callgrind: warm-up, timed, threads.
+    let (mut warm, mut timed) = (1000u64, 2000u64);
+    if let Ok(spec) = std::env::var("FLUIDBED_DEM_BENCH") {
+        let f: Vec<u64> = spec.split(',').filter_map(|s| s.trim().parse().ok()).collect();
+        if f.len() == 3 {
+            (warm, timed, counts) = (f[0], f[1], vec![f[2] as usize]);
+        }
+    }
     for threads in counts {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
         pool.install(|| {

@@ -1,30 +1,45 @@
 //! The two parallel passes of a DEM step, bit-reproducible for a given work split (chunk count):
 //! 1. pair pass: every listed pair once (half list), contiguous particle chunks in parallel, each
-//!    adding the pair forces on i and j into its own buffer (no atomics, no races);
-//! 2. particle pass: sum the chunk buffers for each particle in chunk order, add walls, gravity
-//!    and the external force, and (fused) advance it by AB3.
+//!    adding the pair forces on i and j into its own buffer (no atomics, no races); a listed pair
+//!    costs a distance check, only touching pairs go to the batched contact kernel;
+//! 2. particle pass (`update`): per block, sum the chunk buffers in chunk order, add walls (only
+//!    for the wall list), gravity and the external force, and advance by AB3.
 
-use super::contact::{contact_force, ContactLaw, V3};
 use super::pair_batch::{Batch, CAP};
-use super::integrator::ab_update;
-use super::neighbors::{NeighborList, BLOCK};
+use super::contact::{ContactLaw, V3};
+use super::neighbors::NeighborList;
+use super::walls::{wall_forces, WallList};
 use super::DemParams;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Per-particle past values for the multistep scheme and the wall contact histories.
-#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, PartialEq)]
+/// Particles per block of the particle pass (fixed, so results do not depend on threads).
+pub const BLOCK: usize = 256;
+
+/// Force and n × F_t sums of one particle.
+pub type Acc = [f64; 6];
+
+/// Past derivatives for the multistep scheme, two of each (structure of arrays): velocities
+/// (for x), accelerations (for v), angular accelerations (for ω). `ring` (in the system) says
+/// which slot is the newer one, so a step overwrites the older slot instead of shifting both.
+#[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct Past {
-    /// v_{n−1}, v_{n−2}.
-    pub v: [V3; 2],
-    /// a_{n−1}, a_{n−2}.
-    pub a: [V3; 2],
-    /// Angular accelerations at n−1, n−2.
-    pub alpha: [V3; 2],
-    /// Position at the last neighbour-list build.
-    pub x_build: V3,
-    /// Tangential displacement at the plate, the tube and the lid.
-    pub wall: [V3; 3],
+    pub v: [Vec<V3>; 2],
+    pub a: [Vec<V3>; 2],
+    pub alpha: [Vec<V3>; 2],
+}
+
+impl Past {
+    pub fn zeros(n: usize) -> Past {
+        let z = || [vec![[0.0; 3]; n], vec![[0.0; 3]; n]];
+        Past { v: z(), a: z(), alpha: z() }
+    }
+    /// Particle i now is particle order[i] before.
+    pub fn permute(&mut self, order: &[u32]) {
+        for s in self.v.iter_mut().chain(&mut self.a).chain(&mut self.alpha) {
+            *s = order.iter().map(|&o| s[o as usize]).collect();
+        }
+    }
 }
 
 /// Maxima seen in a pass (max is exact and order-free, so these stay deterministic).
@@ -48,21 +63,27 @@ impl Stats {
 
 /// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
 /// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
-/// partner index of the chunk. The chunks depend only on the list and the thread count, and the
-/// buffers are summed in chunk order, so a run is bit-reproducible for a given thread count.
+/// partner index of the chunk. The chunks depend only on the list and the chunk count, and the
+/// buffers are summed in chunk order, so a run is bit-reproducible for a given chunk count.
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     /// Per chunk: a, b, e.
     pub bounds: Vec<[usize; 3]>,
-    /// Start of each chunk's buffer in `f` and `t`.
+    /// Start of each chunk's buffer in `acc`.
     pub start: Vec<usize>,
-    pub f: Vec<V3>,
-    pub t: Vec<V3>,
+    pub acc: Vec<Acc>,
 }
 
 impl Scratch {
     /// Plan `chunks` chunks (fewer for small systems) over the list.
     pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
+        // The pair pass indexes without bounds checks: check the list once here (it may come
+        // from a checkpoint) — rows ascending within 0..n, histories and flags one per entry.
+        let total = nl.nbr.len();
+        assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
+        assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
+        assert!(nl.nbr.iter().all(|&j| (j as usize) < n), "neighbour list index");
+        assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
         let mut bounds = Vec::with_capacity(nc);
         let mut start = Vec::with_capacity(nc + 1);
@@ -71,20 +92,20 @@ impl Scratch {
             let (a, b) = (c * n / nc, (c + 1) * n / nc);
             let mut e = b;
             for i in a..b {
-                let (k0, k1) = (nl.offsets[i] as usize, nl.offsets[i + 1] as usize);
-                if k1 > k0 {
-                    e = e.max(nl.nbr[k1 - 1] as usize + 1);
+                for &j in &nl.nbr[nl.offsets[i] as usize..nl.offsets[i + 1] as usize] {
+                    assert!(j as usize > i, "half list holds j > i only");
+                    e = e.max(j as usize + 1);
                 }
             }
             bounds.push([a, b, e]);
             start.push(start[c] + e - a);
         }
         let len = start[nc];
-        Scratch { bounds, start, f: vec![[0.0; 3]; len], t: vec![[0.0; 3]; len] }
+        Scratch { bounds, start, acc: vec![[0.0; 6]; len] }
     }
 }
 
-/// Pass 1: all listed pairs, forces and torques accumulated into the chunk buffers.
+/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers.
 pub fn pair_pass<const FR: bool>(
     p: &DemParams,
     x: &[V3],
@@ -96,204 +117,326 @@ pub fn pair_pass<const FR: bool>(
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
     let mut work = Vec::with_capacity(sc.bounds.len());
-    let (mut sh_rest, mut f_rest, mut t_rest) = (&mut nl.shear[..], &mut sc.f[..], &mut sc.t[..]);
+    let (mut sh_rest, mut to_rest, mut acc_rest) = (&mut nl.shear[..], &mut nl.touch[..], &mut sc.acc[..]);
     for &[a, b, e] in &sc.bounds {
-        let (sh, r1) = sh_rest.split_at_mut((offsets[b] - offsets[a]) as usize);
-        let (f, r2) = f_rest.split_at_mut(e - a);
-        let (t, r3) = t_rest.split_at_mut(e - a);
-        (sh_rest, f_rest, t_rest) = (r1, r2, r3);
-        work.push((a, b, sh, f, t));
+        let len = (offsets[b] - offsets[a]) as usize;
+        let (sh, r1) = sh_rest.split_at_mut(if FR { len } else { 0 });
+        let (to, r2) = to_rest.split_at_mut(if FR { len } else { 0 });
+        let (acc, r3) = acc_rest.split_at_mut(e - a);
+        (sh_rest, to_rest, acc_rest) = (r1, r2, r3);
+        work.push((a, b, sh, to, acc));
     }
-    let (d, r) = (2.0 * p.radius, p.radius);
-    let d2 = d * d;
+    let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
     let (law, h) = (&p.pair, p.dt);
     work.into_par_iter()
-        .map(|(a, b, sh, fb, tb)| {
-            fb.fill([0.0; 3]);
-            if FR {
-                tb.fill([0.0; 3]);
-            }
-            let mut st = Stats::ZERO;
-            let base = offsets[a] as usize;
-            let mut batch = Batch::new();
-            let flush = |batch: &mut Batch, sh: &mut [V3], fb: &mut [V3], tb: &mut [V3], st: &mut Stats| {
-                let (ov, ex) = batch.evaluate::<FR>(law, r, h, v, w, sh, base);
-                st.overlap = st.overlap.max(ov);
-                st.coulomb_excess = st.coulomb_excess.max(ex);
-                for l in 0..batch.m {
-                    let (ii, jj) = (batch.i[l] as usize - a, batch.j[l] as usize - a);
-                    for q in 0..3 {
-                        fb[ii][q] += batch.f[q][l];
-                        fb[jj][q] -= batch.f[q][l];
-                    }
-                    if FR {
-                        // Both partners feel R n × F_t (contact points ±R n, forces ±F_t).
-                        for q in 0..3 {
-                            tb[ii][q] += batch.c[q][l];
-                            tb[jj][q] += batch.c[q][l];
-                        }
-                    }
-                }
-                batch.m = 0;
-            };
-            let mut m = 0; // lanes filled (kept in a register; batch.m is set before a flush)
-            for i in a..b {
-                let xi = x[i];
-                let row = &nbr[offsets[i] as usize..offsets[i + 1] as usize];
-                for (kr, &j) in row.iter().enumerate() {
-                    let j = j as usize;
-                    let xj = x[j];
-                    let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-                    let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
-                    let k = offsets[i] as usize + kr;
-                    if r2 >= d2 {
-                        if FR {
-                            sh[k - base] = [0.0; 3];
-                        }
-                        continue;
-                    }
-                    batch.set(m, k, i, j, dx, r2);
-                    m += 1;
-                    if m == CAP {
-                        batch.m = m;
-                        flush(&mut batch, sh, fb, tb, &mut st);
-                        m = 0;
-                    }
-                }
-            }
-            batch.m = m;
-            flush(&mut batch, sh, fb, tb, &mut st);
-            st
+        .map(|(a, b, sh, to, acc)| {
+            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, x, v, w };
+            chunk_pairs_dispatch::<FR>(&args, sh, to, acc)
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-/// One wall contact of particle i: add its force and torque.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn wall_contact<const FR: bool>(
-    law: &ContactLaw, r: f64, h: f64, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3, f: &mut V3, t: &mut V3,
-    st: &mut Stats,
-) {
-    if delta <= 0.0 {
-        *hist = [0.0; 3];
-        return;
-    }
-    let ws = [r * wi[0], r * wi[1], r * wi[2]];
-    let cf = contact_force::<FR>(law, delta, nrm, vi, ws, hist, h);
-    for k in 0..3 {
-        f[k] += cf.f[k];
-        t[k] += r * cf.c[k];
-    }
-    st.overlap = st.overlap.max(delta);
-    if FR {
-        st.coulomb_excess = st.coulomb_excess.max(cf.excess);
-    }
+/// Read-only inputs of one chunk of the pair pass.
+struct ChunkArgs<'a> {
+    law: &'a ContactLaw,
+    r: f64,
+    h: f64,
+    d2: f64,
+    a: usize,
+    b: usize,
+    offsets: &'a [u32],
+    nbr: &'a [u32],
+    x: &'a [V3],
+    v: &'a [V3],
+    w: &'a [V3],
 }
 
-/// Linear and angular acceleration of particle i at the current state (walls update `wall`).
+fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports the features the function is compiled for.
+            return unsafe { chunk_pairs_avx512::<FR>(c, sh, to, acc) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as above.
+            return unsafe { chunk_pairs_avx2::<FR>(c, sh, to, acc) };
+        }
+    }
+    chunk_pairs::<FR>(c, sh, to, acc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+    chunk_pairs::<FR>(c, sh, to, acc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+    chunk_pairs::<FR>(c, sh, to, acc)
+}
+
+/// The pair pass over rows a..b: distance checks, touching pairs batched and evaluated, forces
+/// added into `acc` (particles a..).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub fn accel<const FR: bool>(
-    p: &DemParams, i: usize, xi: V3, vi: V3, wi: V3, wall: &mut [V3; 3], ext: V3, sc: &Scratch, st: &mut Stats,
-) -> (V3, V3) {
-    let mut f = ext;
-    let mut t = [0.0; 3];
-    for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
-        if a <= i && i < e {
-            let k = sc.start[c] + i - a;
-            let q = sc.f[k];
-            f = [f[0] + q[0], f[1] + q[1], f[2] + q[2]];
+fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+    let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, x, v, w } = c;
+    acc.fill([0.0; 6]);
+    let mut st = Stats::ZERO;
+    let base = offsets[a] as usize;
+    let mut batch = Batch::new();
+    // Every entry is written into lane m; only touching ones advance m (no branch).
+    let mut m = 0;
+    for i in a..b {
+        let xi = x[i];
+        let (k0, k1) = (offsets[i] as usize, offsets[i + 1] as usize);
+        for (k, &j) in (k0..k1).zip(&nbr[k0..k1]) {
+            let j = j as usize;
+            // SAFETY: `Scratch::plan` checked i < j < x.len() for every listed pair, and the
+            // chunk's `to` covers its rows' entries k0 - base .. k1 - base.
+            let xj = unsafe { *x.get_unchecked(j) };
+            let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+            let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+            let touching = r2 < d2;
             if FR {
-                let c = sc.t[k];
-                t = [t[0] + c[0], t[1] + c[1], t[2] + c[2]];
+                // The history is live only while the pair keeps touching.
+                let t = unsafe { to.get_unchecked_mut(k - base) };
+                batch.was[m] = *t;
+                *t = touching as u8;
+            }
+            batch.set(m, k, i, j, dx, r2);
+            m += touching as usize;
+            if m == CAP {
+                batch.m = m;
+                flush::<FR>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+                m = 0;
             }
         }
     }
-    let r = p.radius;
-    if FR {
-        t = [r * t[0], r * t[1], r * t[2]];
-    }
-    let (law, h) = (&p.wall, p.dt);
-    // Distributor plate z = 0: normal (0,0,−1).
-    let [w0, w1, w2] = wall;
-    wall_contact::<FR>(law, r, h, r - xi[2], [0.0, 0.0, -1.0], vi, wi, w0, &mut f, &mut t, st);
-    // Tube of radius R_t: outward radial normal.
-    let rho2 = xi[0] * xi[0] + xi[1] * xi[1];
-    let reach = p.tube_radius - r;
-    if rho2 > reach * reach {
-        let rho = rho2.sqrt();
-        let nrm = [xi[0] / rho, xi[1] / rho, 0.0];
-        wall_contact::<FR>(law, r, h, rho - reach, nrm, vi, wi, w1, &mut f, &mut t, st);
-    } else {
-        *w1 = [0.0; 3];
-    }
-    if p.lid {
-        wall_contact::<FR>(law, r, h, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, w2, &mut f, &mut t, st);
-    }
-    let im = 1.0 / p.mass;
-    let g = p.extra_damping;
-    let a = [f[0] * im - g * vi[0], f[1] * im - g * vi[1], f[2] * im - p.gravity - g * vi[2]];
-    let alpha = if FR {
-        let ii = 1.0 / p.inertia;
-        [t[0] * ii - g * wi[0], t[1] * ii - g * wi[1], t[2] * ii - g * wi[2]]
-    } else {
-        [0.0; 3]
-    };
-    (a, alpha)
+    batch.m = m;
+    flush::<FR>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+    st
 }
 
-/// Pass 2 for start-up: accelerations only, into `a` and `alpha`.
+/// Evaluate a batch and add its forces into `acc` (particles a..).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn flush<const FR: bool>(
+    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [V3], base: usize, a: usize,
+    acc: &mut [Acc], st: &mut Stats,
+) {
+    let (ov, ex) = batch.evaluate::<FR>(law, r, h, v, w, sh, base);
+    st.overlap = st.overlap.max(ov);
+    st.coulomb_excess = st.coulomb_excess.max(ex);
+    for l in 0..batch.m {
+        let (ii, jj) = (batch.i[l] as usize - a, batch.j[l] as usize - a);
+        let f = [batch.f[0][l], batch.f[1][l], batch.f[2][l]];
+        let c = if FR { [batch.c[0][l], batch.c[1][l], batch.c[2][l]] } else { [0.0; 3] };
+        // F on i, −F on j; both partners feel R n × F_t (contact points ±R n, forces ±F_t).
+        let on_i = [f[0], f[1], f[2], c[0], c[1], c[2]];
+        let on_j = [-f[0], -f[1], -f[2], c[0], c[1], c[2]];
+        let ai = &mut acc[ii];
+        for q in 0..6 {
+            ai[q] += on_i[q];
+        }
+        let aj = &mut acc[jj];
+        for q in 0..6 {
+            aj[q] += on_j[q];
+        }
+    }
+    batch.m = 0;
+}
+
+/// Accelerations (a, α) of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices): the
+/// external force, then the chunk buffers in chunk order, walls for the wall-list entries
+/// `widx`/`whist`, gravity and the pour's extra damping.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn block_accel<const FR: bool>(
+    p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: &Scratch, widx: &[u32],
+    whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
+) {
+    let hi = lo + out.len();
+    for (o, e) in out.iter_mut().zip(&ext[lo..hi]) {
+        *o = [e[0], e[1], e[2], 0.0, 0.0, 0.0];
+    }
+    for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
+        let (s, t) = (lo.max(a), hi.min(e));
+        if s < t {
+            let buf = &sc.acc[sc.start[c] + s - a..sc.start[c] + t - a];
+            for (o, q) in out[s - lo..t - lo].iter_mut().zip(buf) {
+                for k in 0..6 {
+                    o[k] += q[k];
+                }
+            }
+        }
+    }
+    for (&i, hist) in widx.iter().zip(whist.iter_mut()) {
+        let l = i as usize - lo;
+        let (ov, ex) = wall_forces::<FR>(p, x[l], v[l], w[l], hist, &mut out[l]);
+        st.overlap = st.overlap.max(ov);
+        st.coulomb_excess = st.coulomb_excess.max(ex);
+    }
+    // a = F/m − g e_z − γ v, α = R (Σ n × F_t)/I − γ ω.
+    let (r, im, g, gz) = (p.radius, 1.0 / p.mass, p.extra_damping, p.gravity);
+    let ii = r / p.inertia;
+    for ((o, vi), wi) in out.iter_mut().zip(v).zip(w) {
+        let a = [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]];
+        let alpha = if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] };
+        *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
+    }
+}
+
+/// Wall-list entries split by block, for handing each block its own histories.
+fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> {
+    let mut out = Vec::with_capacity(n.div_ceil(BLOCK));
+    let (mut idx, mut hist) = (&walls.idx[..], &mut walls.hist[..]);
+    for b in 0..n.div_ceil(BLOCK) {
+        let hi = ((b + 1) * BLOCK).min(n);
+        let k = idx.partition_point(|&i| (i as usize) < hi);
+        let (i0, i1) = idx.split_at(k);
+        let (h0, h1) = std::mem::take(&mut hist).split_at_mut(k);
+        out.push((i0, h0));
+        (idx, hist) = (i1, h1);
+    }
+    out
+}
+
+/// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
 #[allow(clippy::too_many_arguments)]
 pub fn accel_pass<const FR: bool>(
-    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], past: &mut [Past], ext: &[V3], sc: &Scratch, a: &mut [V3], alpha: &mut [V3],
+    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], walls: &mut WallList, ext: &[V3], sc: &Scratch, out: &mut [Acc],
 ) -> Stats {
-    past.par_chunks_mut(BLOCK)
-        .zip(a.par_chunks_mut(BLOCK))
-        .zip(alpha.par_chunks_mut(BLOCK))
+    let wb = wall_blocks(walls, x.len());
+    out.par_chunks_mut(BLOCK)
+        .zip(wb)
         .enumerate()
-        .map(|(b, ((ps, ab), lb))| {
+        .map(|(b, (ob, (widx, whist)))| {
             let mut st = Stats::ZERO;
-            for l in 0..ps.len() {
-                let i = b * BLOCK + l;
-                (ab[l], lb[l]) = accel::<FR>(p, i, x[i], v[i], w[i], &mut ps[l].wall, ext[i], sc, &mut st);
-            }
+            let r = b * BLOCK..b * BLOCK + ob.len();
+            block_accel::<FR>(p, r.start, &x[r.clone()], &v[r.clone()], &w[r], ext, sc, widx, whist, ob, &mut st);
             st
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-/// Pass 2, fused: accelerations and the multistep update (weights `hb` = h·b) in one sweep.
-#[allow(clippy::too_many_arguments)]
-pub fn update_pass<const FR: bool>(
-    p: &DemParams, hb: [f64; 3], x: &mut [V3], v: &mut [V3], w: &mut [V3], past: &mut [Past], ext: &[V3],
-    sc: &Scratch,
-) -> Stats {
-    x.par_chunks_mut(BLOCK)
-        .zip(v.par_chunks_mut(BLOCK))
-        .zip(w.par_chunks_mut(BLOCK))
-        .zip(past.par_chunks_mut(BLOCK))
-        .enumerate()
-        .map(|(b, (((xs, vs), ws), ps))| {
-            let mut st = Stats::ZERO;
-            for l in 0..xs.len() {
-                let i = b * BLOCK + l;
-                let (xi, vi, wi) = (xs[l], vs[l], ws[l]);
-                let q = &mut ps[l];
-                let (a, alpha) = accel::<FR>(p, i, xi, vi, wi, &mut q.wall, ext[i], sc, &mut st);
-                let xn = ab_update(xi, vi, q.v[0], q.v[1], hb);
-                vs[l] = ab_update(vi, a, q.a[0], q.a[1], hb);
-                q.v = [vi, q.v[0]];
-                q.a = [a, q.a[0]];
-                if FR {
-                    ws[l] = ab_update(wi, alpha, q.alpha[0], q.alpha[1], hb);
-                    q.alpha = [alpha, q.alpha[0]];
-                }
-                let dd = [xn[0] - q.x_build[0], xn[1] - q.x_build[1], xn[2] - q.x_build[2]];
-                st.disp2 = st.disp2.max(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
-                xs[l] = xn;
-            }
-            st
-        })
+/// Mutable per-particle state of the particle pass.
+pub struct Motion<'a> {
+    pub x: &'a mut [V3],
+    pub v: &'a mut [V3],
+    pub w: &'a mut [V3],
+    pub past: &'a mut Past,
+    pub x_build: &'a [V3],
+    pub walls: &'a mut WallList,
+}
+
+/// One block's share of `Motion`; `older` slots are overwritten with the current derivatives.
+struct BlockMotion<'a> {
+    lo: usize,
+    x: &'a mut [V3],
+    v: &'a mut [V3],
+    w: &'a mut [V3],
+    newer: [&'a [V3]; 3],
+    older: [&'a mut [V3]; 3],
+    widx: &'a [u32],
+    whist: &'a mut [[V3; 3]],
+}
+
+/// Pass 2, fused: accelerations and the multistep update (weights `hb` = h·b; slot `ring` of
+/// `past` holds the newer values, the current derivative overwrites the other) in one sweep.
+pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: Motion, ext: &[V3], sc: &Scratch) -> Stats {
+    let n = m.x.len();
+    let older = 1 - ring;
+    let mut wb = wall_blocks(m.walls, n).into_iter();
+    let [pv, pa, pw] = [&mut m.past.v, &mut m.past.a, &mut m.past.alpha].map(|s| {
+        let (s0, s1) = s.split_at_mut(1);
+        let (s0, s1) = (&mut s0[0][..], &mut s1[0][..]);
+        if older == 0 {
+            (s1.chunks(BLOCK), s0.chunks_mut(BLOCK))
+        } else {
+            (s0.chunks(BLOCK), s1.chunks_mut(BLOCK))
+        }
+    });
+    let (mut nv, mut ov) = pv;
+    let (mut na, mut oa) = pa;
+    let (mut nw, mut ow) = pw;
+    let mut work = Vec::with_capacity(n.div_ceil(BLOCK));
+    for (b, ((x, v), w)) in m.x.chunks_mut(BLOCK).zip(m.v.chunks_mut(BLOCK)).zip(m.w.chunks_mut(BLOCK)).enumerate() {
+        let (widx, whist) = wb.next().expect("wall block");
+        let mut nx = || (nv.next().unwrap(), na.next().unwrap(), nw.next().unwrap());
+        let (a0, a1, a2) = nx();
+        let older = [ov.next().unwrap(), oa.next().unwrap(), ow.next().unwrap()];
+        work.push(BlockMotion { lo: b * BLOCK, x, v, w, newer: [a0, a1, a2], older, widx, whist });
+    }
+    let x_build = m.x_build;
+    work.into_par_iter()
+        .map(|bm| update_block_dispatch::<FR>(p, hb, bm, x_build, ext, sc))
         .reduce(|| Stats::ZERO, Stats::max)
+}
+
+fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx512f") {
+            // SAFETY: the CPU supports the features the function is compiled for.
+            return unsafe { update_block_avx512::<FR>(p, hb, bm, xb, ext, sc) };
+        }
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: as above.
+            return unsafe { update_block_avx2::<FR>(p, hb, bm, xb, ext, sc) };
+        }
+    }
+    update_block::<FR>(p, hb, bm, xb, ext, sc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+unsafe fn update_block_avx512<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+    update_block::<FR>(p, hb, bm, xb, ext, sc)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+    update_block::<FR>(p, hb, bm, xb, ext, sc)
+}
+
+/// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), then f_older ← f (flat arrays, vectorised).
+#[inline(always)]
+fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
+    for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
+        *y += hb[0] * f + hb[1] * f1 + hb[2] * *f2;
+        *f2 = f;
+    }
+}
+
+#[inline(always)]
+fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_build: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+    let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
+    let len = x.len();
+    let mut st = Stats::ZERO;
+    let mut acc = [[0.0; 6]; BLOCK];
+    let acc = &mut acc[..len];
+    block_accel::<FR>(p, lo, x, v, w, ext, sc, widx, whist, acc, &mut st);
+    let mut a = [[0.0; 3]; BLOCK];
+    let mut al = [[0.0; 3]; BLOCK];
+    for ((o, a), al) in acc.iter().zip(&mut a[..len]).zip(&mut al[..len]) {
+        *a = [o[0], o[1], o[2]];
+        *al = [o[3], o[4], o[5]];
+    }
+    let [ov, oa, ow] = older;
+    // x first: it uses the old velocities.
+    let vel: &[f64] = v.as_flattened();
+    ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
+    ab_flat(hb, v.as_flattened_mut(), a[..len].as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
+    if FR {
+        ab_flat(hb, w.as_flattened_mut(), al[..len].as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
+    }
+    for (xn, xb) in x.iter().zip(&x_build[lo..lo + len]) {
+        let dd = [xn[0] - xb[0], xn[1] - xb[1], xn[2] - xb[2]];
+        st.disp2 = st.disp2.max(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
+    }
+    st
 }

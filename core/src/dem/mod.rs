@@ -4,6 +4,7 @@
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
+//! - `walls`: plate, tube and lid contacts for the particles near them;
 //! - `forces`: the two deterministic parallel passes of a step;
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
@@ -15,6 +16,7 @@ pub mod integrator;
 pub mod neighbors;
 pub mod pair_batch;
 pub mod system;
+pub mod walls;
 
 #[cfg(test)]
 mod tests;

@@ -6,8 +6,8 @@
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// Particles per work block in the parallel passes (fixed, so results do not depend on threads).
-pub const BLOCK: usize = 256;
+/// Particles per work block of the list build (fixed, so results do not depend on threads).
+const BLOCK: usize = 256;
 
 /// Half neighbour list in CSR form.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
@@ -15,8 +15,10 @@ pub struct NeighborList {
     /// Row i is nbr[offsets[i]..offsets[i+1]], all j > i.
     pub offsets: Vec<u32>,
     pub nbr: Vec<u32>,
-    /// Tangential displacement ξ of each listed pair (oriented i → j), zero when not touching.
+    /// Tangential displacement ξ of each listed pair (oriented i → j); live only where `touch`.
     pub shear: Vec<[f64; 3]>,
+    /// 1 when the pair touched in the last force evaluation (its history is live), else 0.
+    pub touch: Vec<u8>,
 }
 
 /// Cell order of the particles: the permutation that sorts them by linked cell (stable).
@@ -148,7 +150,7 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList
         }
         nbr.extend_from_slice(&list);
     }
-    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total] }
+    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total] }
 }
 
 impl NeighborList {
@@ -165,7 +167,7 @@ impl NeighborList {
         for i in 0..old_ids.len() {
             for k in old.offsets[i] as usize..old.offsets[i + 1] as usize {
                 let s = old.shear[k];
-                if s == [0.0; 3] {
+                if old.touch[k] == 0 {
                     continue;
                 }
                 let (a, b) = (old_ids[i], old_ids[old.nbr[k] as usize]);
@@ -193,6 +195,7 @@ impl NeighborList {
                 let row = &map[count[lo as usize] as usize..count[lo as usize + 1] as usize];
                 if let Some(&(_, s)) = row.iter().find(|e| e.0 == hi) {
                     self.shear[k] = [sign * s[0], sign * s[1], sign * s[2]];
+                    self.touch[k] = 1;
                 }
             }
         }

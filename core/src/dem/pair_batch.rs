@@ -1,14 +1,21 @@
 //! The particle-particle contact law of `contact::contact_force`, evaluated for a batch of
-//! touching pairs at a time in short loops over independent lanes (PHYSICS.md 2.2-2.3). The
-//! scalar kernel is one long chain of sqrt and division latencies; split into lane loops the
-//! CPU overlaps many pairs (and the compiler can use SIMD), which is where the speed comes from.
+//! touching pairs at a time (PHYSICS.md 2.2-2.3), bit for bit the same as the scalar law.
+//!
+//! Three phases: a scalar gather (velocities, spins and histories of the lanes' particles into
+//! lane arrays), a branch-free lane loop over independent contacts that the compiler turns into
+//! SIMD (the Coulomb limit is a select), and the history write-back. The caller (the pair pass)
+//! is compiled for AVX-512, AVX2 and baseline and picked at run time; Rust never fuses a multiply
+//! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
 use super::contact::{ContactLaw, V3};
 
 /// Pairs per batch.
 pub const CAP: usize = 64;
 
+type Lanes = [f64; CAP];
+
 /// Touching pairs waiting for evaluation (structure of arrays over lanes).
+#[repr(C, align(64))]
 pub struct Batch {
     pub m: usize,
     /// List slot (for the history), first and second particle.
@@ -16,19 +23,19 @@ pub struct Batch {
     pub i: [u32; CAP],
     pub j: [u32; CAP],
     /// x_j − x_i and its squared length.
-    pub dx: [[f64; CAP]; 3],
-    pub r2: [f64; CAP],
-    // Results and intermediates.
-    n: [[f64; CAP]; 3],
-    delta: [f64; CAP],
-    sd: [f64; CAP],
-    qd: [f64; CAP],
-    vn: [f64; CAP],
-    vrel: [[f64; CAP]; 3],
-    fnorm: [f64; CAP],
+    pub dx: [Lanes; 3],
+    pub r2: Lanes,
+    /// 1 when the pair touched in the previous step (its history is live), else 0.
+    pub was: [u8; CAP],
+    // Gathered inputs and per-lane diagnostics.
+    vrel: [Lanes; 3],
+    ws: [Lanes; 3],
+    s: [Lanes; 3],
+    delta: Lanes,
+    excess: Lanes,
     /// Force on i, and n × F_t.
-    pub f: [[f64; CAP]; 3],
-    pub c: [[f64; CAP]; 3],
+    pub f: [Lanes; 3],
+    pub c: [Lanes; 3],
 }
 
 impl Batch {
@@ -41,21 +48,21 @@ impl Batch {
             j: [0; CAP],
             dx: [z; 3],
             r2: z,
-            n: [z; 3],
-            delta: z,
-            sd: z,
-            qd: z,
-            vn: z,
+            was: [1; CAP],
             vrel: [z; 3],
-            fnorm: z,
+            ws: [z; 3],
+            s: [z; 3],
+            delta: z,
+            excess: z,
             f: [z; 3],
             c: [z; 3],
         })
     }
 
-    /// Fill lane `l` (the caller counts lanes and sets `m` before `evaluate`).
+    /// Fill lane `l` < CAP (the caller counts lanes and sets `m` before `evaluate`).
     #[inline(always)]
     pub fn set(&mut self, l: usize, k: usize, i: usize, j: usize, dx: V3, r2: f64) {
+        let l = l % CAP; // a no-op for l < CAP that lets the compiler drop the bounds checks
         self.k[l] = k as u32;
         self.i[l] = i as u32;
         self.j[l] = j as u32;
@@ -65,86 +72,108 @@ impl Batch {
         self.r2[l] = r2;
     }
 
-    /// Evaluate every lane: fills `f` (and `c`, and the history `shear[k − base]` when FR).
-    /// Returns (max overlap, max |F_t|² − (μF_n)²).
+    /// Evaluate every lane: fills `f` (and `c`, and the history `shear[k − base]` when FR; a lane
+    /// with `was` = 0 starts from a zero history). Returns (max overlap, max |F_t|² − (μF_n)²).
     #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
     pub fn evaluate<const FR: bool>(
         &mut self, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [V3], base: usize,
     ) -> (f64, f64) {
-        let m = self.m;
-        let d = 2.0 * r;
-        let mut max_delta: f64 = 0.0;
-        for l in 0..m {
-            let dist = self.r2[l].sqrt();
-            let inv = 1.0 / dist;
-            self.n[0][l] = self.dx[0][l] * inv;
-            self.n[1][l] = self.dx[1][l] * inv;
-            self.n[2][l] = self.dx[2][l] * inv;
-            let delta = d - dist;
-            self.delta[l] = delta;
-            let sd = delta.sqrt();
-            self.sd[l] = sd;
-            self.qd[l] = sd.sqrt(); // δ^{1/4} without powf
-        }
+        let m = self.m.min(CAP);
+        let n = v.len();
+        assert!(w.len() == n || !FR);
         for l in 0..m {
             let (i, j) = (self.i[l] as usize, self.j[l] as usize);
+            assert!(i < n && j < n);
+            // SAFETY: checked just above (one compare for four loads).
+            let (vi, vj) = unsafe { (*v.get_unchecked(i), *v.get_unchecked(j)) };
             for q in 0..3 {
-                self.vrel[q][l] = v[i][q] - v[j][q];
+                self.vrel[q][l] = vi[q] - vj[q];
+            }
+            if FR {
+                let (wi, wj) = unsafe { (*w.get_unchecked(i), *w.get_unchecked(j)) };
+                let s = shear[self.k[l] as usize - base];
+                let live = self.was[l] != 0;
+                for q in 0..3 {
+                    self.ws[q][l] = r * (wi[q] + wj[q]);
+                    self.s[q][l] = if live { s[q] } else { 0.0 };
+                }
             }
         }
-        for l in 0..m {
-            let vn = self.vrel[0][l] * self.n[0][l] + self.vrel[1][l] * self.n[1][l] + self.vrel[2][l] * self.n[2][l];
-            self.vn[l] = vn;
-            let (delta, sd, qd) = (self.delta[l], self.sd[l], self.qd[l]);
-            // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt (PHYSICS.md 2.2)
-            let fnorm = law.kn * delta * sd + law.dn * qd * vn;
-            let fnorm = if law.no_tension { fnorm.max(0.0) } else { fnorm };
-            self.fnorm[l] = fnorm;
-            for q in 0..3 {
-                self.f[q][l] = -fnorm * self.n[q][l];
-            }
-            max_delta = max_delta.max(delta);
+        lanes::<FR>(self, law, 2.0 * r, h);
+        let mut max_delta: f64 = 0.0;
+        for &d in &self.delta[..m] {
+            max_delta = if d > max_delta { d } else { max_delta };
         }
         if !FR {
             return (max_delta, f64::NEG_INFINITY);
         }
         let mut max_excess = f64::NEG_INFINITY;
         for l in 0..m {
-            let (i, j) = (self.i[l] as usize, self.j[l] as usize);
-            let n = [self.n[0][l], self.n[1][l], self.n[2][l]];
-            let ws = [r * (w[i][0] + w[j][0]), r * (w[i][1] + w[j][1]), r * (w[i][2] + w[j][2])];
-            let vn = self.vn[l];
-            // Slip velocity v_ij − (v_ij·n)n + (R_i ω_i + R_j ω_j) × n (PHYSICS.md 2.3)
-            let wn = [ws[1] * n[2] - ws[2] * n[1], ws[2] * n[0] - ws[0] * n[2], ws[0] * n[1] - ws[1] * n[0]];
-            let vt = [
-                self.vrel[0][l] - vn * n[0] + wn[0],
-                self.vrel[1][l] - vn * n[1] + wn[1],
-                self.vrel[2][l] - vn * n[2] + wn[2],
-            ];
-            let slot = &mut shear[self.k[l] as usize - base];
-            let mut s = [slot[0] + vt[0] * h, slot[1] + vt[1] * h, slot[2] + vt[2] * h];
-            let sn = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
-            s = [s[0] - sn * n[0], s[1] - sn * n[1], s[2] - sn * n[2]];
-            let kt = law.kt * self.sd[l];
-            let et = law.dt * self.qd[l];
-            let mut ft = [-kt * s[0] - et * vt[0], -kt * s[1] - et * vt[1], -kt * s[2] - et * vt[2]];
-            let ft2 = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2];
-            let lim = law.mu * self.fnorm[l].abs();
-            if ft2 > lim * lim {
-                // Coulomb: |F_t| = μ F_n, damping dropped, ξ reset to match the spring alone.
-                let scale = if ft2 > 0.0 { lim / ft2.sqrt() } else { 0.0 };
-                ft = [ft[0] * scale, ft[1] * scale, ft[2] * scale];
-                s = [-ft[0] / kt, -ft[1] / kt, -ft[2] / kt];
-            }
-            *slot = s;
-            for q in 0..3 {
-                self.f[q][l] += ft[q];
-            }
-            self.c[0][l] = n[1] * ft[2] - n[2] * ft[1];
-            self.c[1][l] = n[2] * ft[0] - n[0] * ft[2];
-            self.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
-            max_excess = max_excess.max(ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim * lim);
+            let e = self.excess[l];
+            max_excess = if e > max_excess { e } else { max_excess };
+            shear[self.k[l] as usize - base] = [self.s[0][l], self.s[1][l], self.s[2][l]];
         }
         (max_delta, max_excess)
+    }
+}
+
+impl Default for Box<Batch> {
+    fn default() -> Self {
+        Batch::new()
+    }
+}
+
+/// The contact law over lanes 0..m, no branches (the same operations as `contact_force`).
+#[inline(always)]
+fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
+    let m = b.m;
+    let (kn, dn, ktl, dtl, mu, nt) = (law.kn, law.dn, law.kt, law.dt, law.mu, law.no_tension);
+    for l in 0..m {
+        let dist = b.r2[l].sqrt();
+        let inv = 1.0 / dist;
+        let n = [b.dx[0][l] * inv, b.dx[1][l] * inv, b.dx[2][l] * inv];
+        let delta = d - dist;
+        b.delta[l] = delta;
+        let sd = delta.sqrt();
+        let qd = sd.sqrt(); // δ^{1/4} without powf
+        let vr = [b.vrel[0][l], b.vrel[1][l], b.vrel[2][l]];
+        let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
+        // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt (PHYSICS.md 2.2)
+        let fnorm = kn * delta * sd + dn * qd * vn;
+        let fnorm = if nt { fnorm.max(0.0) } else { fnorm };
+        let mut f = [-fnorm * n[0], -fnorm * n[1], -fnorm * n[2]];
+        if FR {
+            let ws = [b.ws[0][l], b.ws[1][l], b.ws[2][l]];
+            // Slip velocity v_ij − (v_ij·n)n + (R_i ω_i + R_j ω_j) × n (PHYSICS.md 2.3)
+            let wn = [ws[1] * n[2] - ws[2] * n[1], ws[2] * n[0] - ws[0] * n[2], ws[0] * n[1] - ws[1] * n[0]];
+            let vt = [vr[0] - vn * n[0] + wn[0], vr[1] - vn * n[1] + wn[1], vr[2] - vn * n[2] + wn[2]];
+            let mut s = [b.s[0][l] + vt[0] * h, b.s[1][l] + vt[1] * h, b.s[2][l] + vt[2] * h];
+            let sn = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
+            s = [s[0] - sn * n[0], s[1] - sn * n[1], s[2] - sn * n[2]];
+            let kt = ktl * sd;
+            let et = dtl * qd;
+            let ft0 = [-kt * s[0] - et * vt[0], -kt * s[1] - et * vt[1], -kt * s[2] - et * vt[2]];
+            let ft2 = ft0[0] * ft0[0] + ft0[1] * ft0[1] + ft0[2] * ft0[2];
+            let lim = mu * fnorm.abs();
+            // Coulomb: |F_t| = μ F_n, damping dropped, ξ reset to match the spring alone.
+            let slide = ft2 > lim * lim;
+            let scale = lim / ft2.sqrt();
+            let mut ft = ft0;
+            for q in 0..3 {
+                let scaled = ft0[q] * scale;
+                ft[q] = if slide { scaled } else { ft0[q] };
+                let reset = -ft[q] / kt;
+                b.s[q][l] = if slide { reset } else { s[q] };
+                f[q] += ft[q];
+            }
+            b.c[0][l] = n[1] * ft[2] - n[2] * ft[1];
+            b.c[1][l] = n[2] * ft[0] - n[0] * ft[2];
+            b.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
+            b.excess[l] = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim * lim;
+        }
+        for q in 0..3 {
+            b.f[q][l] = f[q];
+        }
     }
 }

@@ -3,9 +3,10 @@
 //! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
 
 use super::contact::V3;
-use super::forces::{accel_pass, pair_pass, update_pass, Past, Scratch, Stats};
+use super::forces::{accel_pass, pair_pass, update_pass, Acc, Motion, Past, Scratch, Stats};
 use super::integrator::weights;
 use super::neighbors::{build_list, cell_order, NeighborList};
+use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
 use serde::{Deserialize, Serialize};
@@ -17,10 +18,15 @@ pub struct DemSystem {
     pub(super) x: Vec<V3>,
     pub(super) v: Vec<V3>,
     pub(super) w: Vec<V3>,
-    pub(super) past: Vec<Past>,
+    pub(super) past: Past,
+    /// Slot of `past` holding the newer values.
+    ring: u8,
+    /// Positions at the last neighbour-list build.
+    x_build: Vec<V3>,
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
     pub(super) nl: NeighborList,
+    pub(super) walls: WallList,
     /// Derivative levels held for the multistep scheme: 0 → Heun next, 2 → AB2, 3 → AB3.
     levels: u8,
     steps: u64,
@@ -49,10 +55,13 @@ impl DemSystem {
             x: positions,
             v: velocities,
             w: vec![[0.0; 3]; n],
-            past: vec![Past::default(); n],
+            past: Past::zeros(n),
+            ring: 0,
+            x_build: Vec::new(),
             ext: vec![[0.0; 3]; n],
             ids: (0..n as u32).collect(),
             nl: NeighborList::default(),
+            walls: WallList::default(),
             levels: 0,
             steps: 0,
             time: 0.0,
@@ -175,8 +184,16 @@ impl DemSystem {
             let h = self.p.dt;
             let b = weights(self.levels);
             let hb = [h * b[0], h * b[1], h * b[2]];
-            let (x, v, w, past) = (&mut self.x, &mut self.v, &mut self.w, &mut self.past);
-            let st = update_pass::<FR>(&self.p, hb, x, v, w, past, &self.ext, &self.sc);
+            let m = Motion {
+                x: &mut self.x,
+                v: &mut self.v,
+                w: &mut self.w,
+                past: &mut self.past,
+                x_build: &self.x_build,
+                walls: &mut self.walls,
+            };
+            let st = update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, &self.sc);
+            self.ring = 1 - self.ring;
             self.levels = (self.levels + 1).min(3);
             st
         };
@@ -195,40 +212,38 @@ impl DemSystem {
     fn heun<const FR: bool>(&mut self) -> Stats {
         let n = self.x.len();
         let h = self.p.dt;
-        let (mut a0, mut l0) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-        let st = accel_pass::<FR>(
-            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.sc, &mut a0, &mut l0,
-        );
+        let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
+        let st = accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d0);
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
-        let (shear1, past1) = (self.nl.shear.clone(), self.past.clone());
-        let step = |y: &V3, f: &V3, c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
+        let (shear1, touch1, walls1) = (self.nl.shear.clone(), self.nl.touch.clone(), self.walls.clone());
+        let step = |y: &V3, f: &[f64], c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
         for i in 0..n {
             self.x[i] = step(&x0[i], &v0[i], h);
-            self.v[i] = step(&v0[i], &a0[i], h);
-            self.w[i] = step(&w0[i], &l0[i], h);
+            self.v[i] = step(&v0[i], &d0[i][..3], h);
+            self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
         pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
-        let (mut a1, mut l1) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
-        accel_pass::<FR>(
-            &self.p, &self.x, &self.v, &self.w, &mut self.past, &self.ext, &self.sc, &mut a1, &mut l1,
-        );
-        self.nl.shear = shear1;
-        self.past = past1;
+        let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
+        accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
+        (self.nl.shear, self.nl.touch, self.walls) = (shear1, touch1, walls1);
         let mut disp2: f64 = 0.0;
+        let newer = 1 - self.ring as usize;
         for i in 0..n {
             let vs = self.v[i];
             self.x[i] = step(&step(&x0[i], &v0[i], 0.5 * h), &vs, 0.5 * h);
-            self.v[i] = step(&step(&v0[i], &a0[i], 0.5 * h), &a1[i], 0.5 * h);
+            self.v[i] = step(&step(&v0[i], &d0[i][..3], 0.5 * h), &d1[i][..3], 0.5 * h);
             if FR {
-                self.w[i] = step(&step(&w0[i], &l0[i], 0.5 * h), &l1[i], 0.5 * h);
+                self.w[i] = step(&step(&w0[i], &d0[i][3..], 0.5 * h), &d1[i][3..], 0.5 * h);
             }
-            let q = &mut self.past[i];
-            q.v[0] = v0[i];
-            q.a[0] = a0[i];
-            q.alpha[0] = l0[i];
-            let d: f64 = (0..3).map(|k| (self.x[i][k] - q.x_build[k]).powi(2)).sum();
+            let q = &mut self.past;
+            q.v[newer][i] = v0[i];
+            q.a[newer][i] = [d0[i][0], d0[i][1], d0[i][2]];
+            q.alpha[newer][i] = [d0[i][3], d0[i][4], d0[i][5]];
+            let xb = self.x_build[i];
+            let d: f64 = (0..3).map(|k| (self.x[i][k] - xb[k]).powi(2)).sum();
             disp2 = disp2.max(d);
         }
+        self.ring = newer as u8;
         self.levels = 2;
         Stats { disp2, ..st }
     }
@@ -241,7 +256,7 @@ impl DemSystem {
         self.v = perm(&self.v);
         self.w = perm(&self.w);
         self.ext = perm(&self.ext);
-        self.past = order.iter().map(|&o| self.past[o as usize]).collect();
+        self.past.permute(&order);
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
         let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff);
@@ -249,10 +264,10 @@ impl DemSystem {
             nl.carry_history(&self.nl, &old_ids, &self.ids);
         }
         self.nl = nl;
+        let had_walls = !self.x_build.is_empty();
+        self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc = Scratch::default();
-        for (q, x) in self.past.iter_mut().zip(&self.x) {
-            q.x_build = *x;
-        }
+        self.x_build = self.x.clone();
         self.rebuild_due = false;
     }
 }
