@@ -64,7 +64,7 @@ impl Image {
         ihdr.extend_from_slice(&(self.height as u32).to_be_bytes());
         ihdr.extend_from_slice(&[8, 2, 0, 0, 0]); // 8-bit, RGB, deflate, adaptive filter, no interlace
         chunk(&mut out, b"IHDR", &ihdr);
-        chunk(&mut out, b"IDAT", &zlib_stored(&raw));
+        chunk(&mut out, b"IDAT", &miniz_oxide::deflate::compress_to_vec_zlib(&raw, 6));
         chunk(&mut out, b"IEND", &[]);
         out
     }
@@ -77,26 +77,6 @@ fn chunk(out: &mut Vec<u8>, kind: &[u8; 4], data: &[u8]) {
     out.extend_from_slice(data);
     let crc = crc32(&out[start..]);
     out.extend_from_slice(&crc.to_be_bytes());
-}
-
-/// zlib stream of stored (uncompressed) deflate blocks of at most 65535 bytes, with Adler-32.
-fn zlib_stored(data: &[u8]) -> Vec<u8> {
-    let mut out = vec![0x78, 0x01];
-    let blocks: Vec<&[u8]> = if data.is_empty() { vec![&[][..]] } else { data.chunks(65535).collect() };
-    for (n, b) in blocks.iter().enumerate() {
-        out.push(u8::from(n + 1 == blocks.len()));
-        let len = b.len() as u16;
-        out.extend_from_slice(&len.to_le_bytes());
-        out.extend_from_slice(&(!len).to_le_bytes());
-        out.extend_from_slice(b);
-    }
-    let (mut a, mut s) = (1u32, 0u32);
-    for &x in data {
-        a = (a + x as u32) % 65521;
-        s = (s + a) % 65521;
-    }
-    out.extend_from_slice(&((s << 16) | a).to_be_bytes());
-    out
 }
 
 /// CRC-32 (ISO 3309, polynomial 0xEDB88320) as PNG uses it.
