@@ -332,18 +332,20 @@ pub enum Voidage {
         cube_side_factor: f64,
     },
     /// Exact sphere volume split straight onto the cylindrical cells: exact per fluid layer,
-    /// exact slice areas on the polar cells integrated by Gauss–Legendre in z (ours; the default).
+    /// exact slice areas on the polar cells integrated by Gauss–Legendre in z (ours).
     ExactCylindrical,
 }
 
-/// Default: the exact-cylindrical split. Measured (docs/BENCHMARKS.md "## Voidage", 44-mm grid,
-/// random packings at ε 0.4–0.9): mean cell-voidage error 1e-4 against 1e-2 for the paper's
-/// square grid (cuboid, configuration 3), i.e. ~100× more accurate, for ~0.66 µs instead of
-/// ~0.05 µs per particle per coupling step — small beside the DEM work, since the voidage is
-/// computed once per gas step. The paper's method stays one `"method": "square_grid"` away.
+/// Default: the paper's square grid, configuration 3 (boxes just above d), cuboid split.
+/// Measured (docs/BENCHMARKS.md "## Voidage", 44-mm grid): mean cell-voidage error 1e-2 for
+/// ~0.05 µs per particle per coupling step; `exact_cylindrical` is ~100× more accurate (1e-4)
+/// but costs ~0.66 µs, and the voidage is recomputed at every gas step (every 1-2 DEM steps), so
+/// it would cost several times the contact work itself (quickstart: square-grid voidage 30 s
+/// against DEM 30 s of a 120-s run). Choose `exact_cylindrical` where accuracy of the voidage
+/// field matters more than run time.
 impl Default for Voidage {
     fn default() -> Self {
-        Voidage::ExactCylindrical
+        Voidage::SquareGrid { box_side_m: None, split: BoxSplit::Cuboid, cube_side_factor: 1.0 }
     }
 }
 
