@@ -31,7 +31,20 @@ pub fn one_second_run() -> RunSummary {
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
     let t0 = std::time::Instant::now();
-    let (sim, snaps) = run_case(case, "bubbling");
+    let mut sim = fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build");
+    let mut snaps = Vec::new();
+    while !sim.is_finished() {
+        if let Some(s) = sim.advance(u64::MAX).unwrap_or_else(|e| panic!("bubbling: {e}")) {
+            if s.index % 10 == 0 {
+                eprintln!("[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s", s.time_s, s.pressure_drop_pa.unwrap_or(0.0), t0.elapsed().as_secs_f64());
+                // the ΔP series so far, in case the run is stopped early
+                let dp: Vec<(f64, f64)> = snaps.iter().chain(std::iter::once(&s)).filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p))).collect();
+                std::fs::create_dir_all("target/validate-cache").expect("cache dir");
+                std::fs::write(format!("{CACHE}.partial"), serde_json::to_string(&dp).unwrap()).expect("write partial");
+            }
+            snaps.push(s);
+        }
+    }
     let mut bubble_fraction_max: f64 = 0.0;
     for s in snaps.iter().filter(|s| s.time_s >= 0.4 - 1e-9) {
         let eps = s.voidage.as_ref().unwrap();
