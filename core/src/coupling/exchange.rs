@@ -75,6 +75,51 @@ pub struct Exchange {
     drag: Vec<[f64; 3]>,
     /// Frozen beds: per cell, particle count and Σcos, Σsin of (θ_p − θ_c) (see `frozen_cell_forces`).
     frozen: Vec<(f64, f64, f64)>,
+    /// Beetstra's per-cell factors, refreshed each call.
+    cell_drag: Vec<CellDrag>,
+}
+
+/// Everything in the drag law that depends on the cell only (PHYSICS.md 1.1 with ε clamped), so
+/// that a particle pays one ln and two exp instead of three powf:
+/// F = F₀ + b·Re·(c + 8.4 Re^−0.343)/(1 + p10·Re^e1), F_d = k·F·(u − v), Re = re_per_w·|u − v|.
+#[derive(Clone, Copy, Default)]
+struct CellDrag {
+    k: f64,
+    f0: f64,
+    b: f64,
+    c: f64,
+    p10: f64,
+    e1: f64,
+    re_per_w: f64,
+}
+
+impl CellDrag {
+    fn new(mu: f64, rho: f64, d: f64, eps: f64, eps_min: f64) -> CellDrag {
+        let eps = eps.clamp(eps_min, 1.0 - f64::EPSILON);
+        let phi = 1.0 - eps;
+        CellDrag {
+            k: 3.0 * PI * mu * d * eps,
+            f0: 10.0 * phi / (eps * eps) + eps * eps * (1.0 + 1.5 * phi.max(0.0).sqrt()),
+            b: 0.413 / (24.0 * eps * eps),
+            c: 1.0 / eps + 3.0 * eps * phi,
+            p10: 10f64.powf(3.0 * phi),
+            e1: -(1.0 + 4.0 * phi) / 2.0,
+            re_per_w: rho * eps * d / mu,
+        }
+    }
+    #[inline]
+    fn force(&self, slip: [f64; 3]) -> [f64; 3] {
+        let w = (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]).sqrt();
+        let re = self.re_per_w * w;
+        let f = if re < 1e-12 {
+            self.f0
+        } else {
+            let l = re.ln();
+            self.f0 + self.b * re * (self.c + 8.4 * (-0.343 * l).exp()) / (1.0 + self.p10 * (self.e1 * l).exp())
+        };
+        let kf = self.k * f;
+        [kf * slip[0], kf * slip[1], kf * slip[2]]
+    }
 }
 
 impl Exchange {
@@ -86,7 +131,7 @@ impl Exchange {
                 cell_basis.push((th.cos(), th.sin()));
             }
         }
-        Exchange { cell_basis, cell_of: vec![0; particles], drag: vec![[0.0; 3]; particles], frozen: Vec::new() }
+        Exchange { cell_basis, cell_of: vec![0; particles], drag: vec![[0.0; 3]; particles], frozen: Vec::new(), cell_drag: Vec::new() }
     }
 
     /// See the free function `particle_gas_forces`; no allocation.
@@ -109,6 +154,11 @@ impl Exchange {
         self.cell_of.resize(pos.len(), 0);
         self.drag.resize(pos.len(), [0.0; 3]);
         let vp = PI * d * d * d / 6.0;
+        self.cell_drag.resize(grid.num_cells(), CellDrag::default());
+        for (c, cd) in self.cell_drag.iter_mut().enumerate() {
+            *cd = CellDrag::new(mu, gas.density[c], d, gas.voidage[c], eps_min);
+        }
+        let cell_drag = &self.cell_drag;
         // 1. per particle (parallel): its cell, the drag, and the total force −V_p∇p + drag, with
         //    the gas vectors turned to Cartesian at the particle's own angle (paper section 2.3)
         (force_out, &mut self.drag[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
@@ -117,7 +167,7 @@ impl Exchange {
                 let (cos, sin) = angle_of(p[0], p[1]);
                 let u = cyl_to_cart(gas.velocity_cyl[c], cos, sin);
                 let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
-                *dr = drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, slip);
+                *dr = cell_drag[c].force(slip);
                 let g = cyl_to_cart(gas.grad_p_cyl[c], cos, sin);
                 *f = [dr[0] - vp * g[0], dr[1] - vp * g[1], dr[2] - vp * g[2]];
                 *co = c as u32;
@@ -304,6 +354,20 @@ mod tests {
         for c in 0..n {
             for m in 0..3 {
                 assert!((full[c][m] - fast[c][m]).abs() <= 1e-12 * scale, "cell {c}: {:?} vs {:?}", full[c], fast[c]);
+            }
+        }
+    }
+
+    #[test]
+    fn per_cell_factors_reproduce_the_drag_law() {
+        for &eps in &[0.05, 0.3, 0.4, 0.6, 0.9, 0.999] {
+            for &w in &[0.0, 1e-9, 1e-3, 0.1, 0.6, 3.0] {
+                let slip = [0.3 * w, -0.2 * w, w];
+                let a = drag_force(1.8e-5, 1.2, 1.2e-3, eps, 0.1, slip);
+                let b = CellDrag::new(1.8e-5, 1.2, 1.2e-3, eps, 0.1).force(slip);
+                for m in 0..3 {
+                    assert!((a[m] - b[m]).abs() <= 1e-13 * a[2].abs().max(1e-300), "ε={eps} w={w}: {a:?} vs {b:?}");
+                }
             }
         }
     }
