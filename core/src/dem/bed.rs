@@ -5,14 +5,22 @@
 //!
 //! For a settled height H we pour more than enough particles (count from an estimated packing
 //! fraction of 0.60, plus 15 %), settle, then remove every particle whose top is above H
-//! (centre above H − R) and relax again with the case's real parameters. The pour itself uses
-//! extra damping to settle fast: a viscous rate of 5 /s on v and ω and normal damping α for
-//! e = 0.3. The final relaxation uses the case's contact law and no extra damping.
+//! (centre above H − R) and relax again.
+//!
+//! Speed (the pour is most of a first run): the pour uses softer particles, E_pour =
+//! max(E/100, 1000 ρ (1 m/s)²) — the floor keeps the Hertz overlap of a 1 m/s impact below about
+//! 6 % of d, as δ/R depends only on ρv²/E — and the step dt_pour = t_c(E_pour, 1 m/s)/20 (Hertz
+//! contact time, PHYSICS.md 2.4; E/100 makes t_c and the step 100^0.4 ≈ 6.3 times larger). Damping
+//! is strong: normal e = 0.3 and a viscous rate of 20 /s on v and ω (terminal speed g/20 ≈ 0.5 m/s,
+//! so impacts stay gentle). Particles are inserted at a solid fraction of 0.34, close to their
+//! final height. Once still, the contacts are stiffened in steps of √10 in E (each with its own
+//! t_c/20 step, the last with the case's step) so the overlaps shrink without a jolt, and a final
+//! relaxation uses the case's own contact law and no extra damping.
 
 use super::contact::V3;
 use super::system::DemSystem;
 use super::DemParams;
-use crate::case::{Bed, Case, Damping};
+use crate::case::{Bed, Case, Damping, CHECK_IMPACT_SPEED_M_S};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::path::Path;
@@ -20,7 +28,14 @@ use std::path::Path;
 /// Estimated random packing fraction used to turn a height into a count.
 const PACKING_ESTIMATE: f64 = 0.60;
 /// Packing fraction of the random insertion (random sequential addition jams near 0.38).
-const INSERT_FRACTION: f64 = 0.30;
+const INSERT_FRACTION: f64 = 0.34;
+/// Softening of the pour: E_pour = max(E / POUR_SOFTENING, POUR_E_FLOOR_RHO_V2 · ρ · (1 m/s)²).
+const POUR_SOFTENING: f64 = 100.0;
+const POUR_E_FLOOR_RHO_V2: f64 = 1000.0;
+/// Extra viscous damping rate (1/s) while pouring and stiffening.
+const POUR_DAMPING: f64 = 20.0;
+/// Pour step = Hertz contact time at 1 m/s over this.
+const POUR_STEPS_PER_CONTACT: f64 = 20.0;
 /// Settled when the mean kinetic energy per particle is below ½ m v² with this v (m/s).
 const POUR_SPEED: f64 = 2e-3;
 const RELAX_SPEED: f64 = 1e-3;
@@ -29,7 +44,7 @@ const MAX_PHASE_TIME_S: f64 = 5.0;
 /// Fixed work split while pouring, so the bed does not depend on the thread count.
 const BED_CHUNKS: usize = 8;
 /// Bump when the algorithm changes (invalidates cached beds).
-const ALGORITHM_VERSION: u32 = 1;
+const ALGORITHM_VERSION: u32 = 2;
 
 /// The settled bed for `case` (positions, velocities); explicit beds are returned as given.
 pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<V3>), String> {
@@ -76,33 +91,54 @@ pub fn generate(
     };
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let x = insert_random(case, n, &mut rng)?;
-    // Pour with extra damping (fast settling); no lid while pouring.
-    let mut pour_case = case.clone();
-    pour_case.particles.normal_damping = Damping::Restitution(0.3);
-    let mut p = DemParams::new(&pour_case);
-    p.lid = false;
-    p.extra_damping = 5.0;
-    p.work_chunks = BED_CHUNKS;
-    let mut sys = DemSystem::with_params(p, x, vec![[0.0; 3]; n]);
+    // Pour soft and damped (fast settling); no lid while pouring.
+    let e_real = case.particles.youngs_modulus_pa;
+    let e_floor = POUR_E_FLOOR_RHO_V2 * case.particles.density_kg_m3;
+    let e_pour = (e_real / POUR_SOFTENING).max(e_floor).min(e_real);
+    let mut sys = DemSystem::with_params(pour_params(case, e_pour, false), x, vec![[0.0; 3]; n]);
     settle(&mut sys, POUR_SPEED, observe)?;
-    let (mut x, mut v) = (sys.positions().to_vec(), sys.velocities().to_vec());
     if let (None, Some(h)) = (count, height) {
         let r = case.particles.diameter_m / 2.0;
+        let x = sys.positions();
         let top = x.iter().map(|p| p[2]).fold(0.0, f64::max);
         if top < h - r {
             return Err(format!("poured bed reaches only {top:.4} m, below the requested {h} m"));
         }
         let keep: Vec<usize> = (0..x.len()).filter(|&i| x[i][2] <= h - r).collect();
-        x = keep.iter().map(|&i| x[i]).collect();
-        v = keep.iter().map(|&i| v[i]).collect();
+        let (x, v) = (keep.iter().map(|&i| x[i]).collect(), keep.iter().map(|&i| sys.velocities()[i]).collect());
+        sys = DemSystem::with_params(pour_params(case, e_pour, false), x, v);
+    }
+    // Stiffen in steps of √10 in E, still damped, each until still.
+    let mut e = e_pour;
+    while e < e_real {
+        e = (e * 10f64.sqrt()).min(e_real);
+        sys.set_params(pour_params(case, e, e >= e_real));
+        settle(&mut sys, POUR_SPEED, observe)?;
     }
     // Final relaxation with the case's own parameters.
     let mut p = DemParams::new(case);
     p.lid = false;
     p.work_chunks = BED_CHUNKS;
-    let mut sys = DemSystem::with_params(p, x, v);
+    sys.set_params(p);
     settle(&mut sys, RELAX_SPEED, observe)?;
     Ok((sys.positions().to_vec(), sys.velocities().to_vec()))
+}
+
+/// Pour parameters at Young's modulus `e`: normal e = 0.3, extra viscous damping, no lid, fixed
+/// work split, step t_c(e)/20 (the case's own step when `last`).
+fn pour_params(case: &Case, e: f64, last: bool) -> DemParams {
+    let mut c = case.clone();
+    c.particles.youngs_modulus_pa = e;
+    c.particles.normal_damping = Damping::Restitution(0.3);
+    if !last {
+        let dt = c.hertz_contact_time_s(CHECK_IMPACT_SPEED_M_S) / POUR_STEPS_PER_CONTACT;
+        c.dem.time_step_s = dt.max(case.dem.time_step_s);
+    }
+    let mut p = DemParams::new(&c);
+    p.lid = false;
+    p.extra_damping = POUR_DAMPING;
+    p.work_chunks = BED_CHUNKS;
+    p
 }
 
 /// Step until the mean kinetic energy per particle falls below ½ m `speed`², checked every 200 steps.

@@ -83,7 +83,7 @@ impl Scratch {
         assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
         assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
         assert!(nl.nbr.iter().all(|&j| (j as usize) < n), "neighbour list index");
-        assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
+        assert!(nl.shear.len() == total && nl.touch.len() == total && nl.gap.len() == total, "contact history length");
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
         let mut bounds = Vec::with_capacity(nc);
         let mut start = Vec::with_capacity(nc + 1);
@@ -105,7 +105,9 @@ impl Scratch {
     }
 }
 
-/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers.
+/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers. Pairs whose
+/// gap at the list build exceeds `reach` (twice the largest displacement since, plus a margin)
+/// cannot touch and are skipped: rows are sorted by that gap, so a row stops at the first one.
 pub fn pair_pass<const FR: bool>(
     p: &DemParams,
     x: &[V3],
@@ -113,9 +115,11 @@ pub fn pair_pass<const FR: bool>(
     w: &[V3],
     nl: &mut NeighborList,
     sc: &mut Scratch,
+    reach: f64,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
+    let gap = &nl.gap;
     let mut work = Vec::with_capacity(sc.bounds.len());
     let (mut sh_rest, mut to_rest, mut acc_rest) = (&mut nl.shear[..], &mut nl.touch[..], &mut sc.acc[..]);
     for &[a, b, e] in &sc.bounds {
@@ -130,7 +134,7 @@ pub fn pair_pass<const FR: bool>(
     let (law, h) = (&p.pair, p.dt);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
-            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, x, v, w };
+            let args = ChunkArgs { law, r, h, d2, reach, a, b, offsets, nbr, gap, x, v, w };
             chunk_pairs_dispatch::<FR>(&args, sh, to, acc)
         })
         .reduce(|| Stats::ZERO, Stats::max)
@@ -142,10 +146,12 @@ struct ChunkArgs<'a> {
     r: f64,
     h: f64,
     d2: f64,
+    reach: f64,
     a: usize,
     b: usize,
     offsets: &'a [u32],
     nbr: &'a [u32],
+    gap: &'a [f32],
     x: &'a [V3],
     v: &'a [V3],
     w: &'a [V3],
@@ -182,7 +188,7 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mu
 /// added into `acc` (particles a..).
 #[inline(always)]
 fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
-    let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, x, v, w } = c;
+    let &ChunkArgs { law, r, h, d2, reach, a, b, offsets, nbr, gap, x, v, w } = c;
     acc.fill([0.0; 6]);
     let mut st = Stats::ZERO;
     let base = offsets[a] as usize;
@@ -191,7 +197,10 @@ fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc:
     let mut m = 0;
     for i in a..b {
         let xi = x[i];
-        let (k0, k1) = (offsets[i] as usize, offsets[i + 1] as usize);
+        let (k0, mut k1) = (offsets[i] as usize, offsets[i + 1] as usize);
+        if let Some(stop) = gap[k0..k1].iter().position(|&g| g as f64 > reach) {
+            k1 = k0 + stop;
+        }
         for (k, &j) in (k0..k1).zip(&nbr[k0..k1]) {
             let j = j as usize;
             // SAFETY: `Scratch::plan` checked i < j < x.len() for every listed pair, and the

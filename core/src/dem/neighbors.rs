@@ -1,6 +1,6 @@
 //! O(N) neighbour search: linked cells give the cell order (particles are re-sorted by cell
 //! at every rebuild for memory locality) and a half Verlet list (each pair once, j > i) in CSR
-//! form with the tangential contact history stored parallel to it. History survives rebuilds
+//! form, rows sorted by the gap to contact, with the tangential contact history parallel to it. History survives rebuilds
 //! by particle-id pair. Everything here is deterministic and independent of the thread count.
 
 use rayon::prelude::*;
@@ -19,6 +19,9 @@ pub struct NeighborList {
     pub shear: Vec<[f64; 3]>,
     /// 1 when the pair touched in the last force evaluation (its history is live), else 0.
     pub touch: Vec<u8>,
+    /// Gap |x_j − x_i| − d of each pair at the build; rows are sorted by it, so the pair pass
+    /// can stop a row at the first pair that cannot have closed its gap since the build.
+    pub gap: Vec<f32>,
 }
 
 /// Cell order of the particles: the permutation that sorts them by linked cell (stable).
@@ -79,8 +82,8 @@ impl CellGrid {
 }
 
 /// Build the half list for particles already sorted by cell (`x` in cell order), pairs closer
-/// than `cutoff`. Row j-indices come out ascending.
-pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList {
+/// than `cutoff`, each row sorted by the gap to contact (centre distance − `diameter`).
+pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) -> NeighborList {
     let grid = CellGrid::new(x, tube_radius, cutoff);
     let ncell = grid.len();
     let cells: Vec<usize> = x.iter().map(|p| grid.cell_of(p)).collect();
@@ -94,12 +97,14 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList
     let c2 = cutoff * cutoff;
     let [nx, ny, nz] = grid.n;
     // Rows built per block in parallel, concatenated in block order.
-    let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(BLOCK))
+    let rows: Vec<(Vec<u32>, Vec<u32>, Vec<f32>)> = (0..x.len().div_ceil(BLOCK))
         .into_par_iter()
         .map(|b| {
             let (a, e) = (b * BLOCK, ((b + 1) * BLOCK).min(x.len()));
             let mut counts = Vec::with_capacity(e - a);
             let mut list = Vec::with_capacity((e - a) * 8);
+            let mut gaps = Vec::with_capacity((e - a) * 8);
+            let mut row: Vec<(f32, u32)> = Vec::new();
             for i in a..e {
                 let before = list.len();
                 let c = cells[i];
@@ -128,29 +133,35 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64) -> NeighborList
                             let lo = (start[cc] as usize).max(i + 1);
                             for j in lo..start[cc + 1] as usize {
                                 let d = [x[j][0] - xi[0], x[j][1] - xi[1], x[j][2] - xi[2]];
-                                if d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < c2 {
-                                    list.push(j as u32);
+                                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                                if r2 < c2 {
+                                    row.push(((r2.sqrt() - diameter) as f32, j as u32));
                                 }
                             }
                         }
                     }
                 }
+                row.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
+                list.extend(row.iter().map(|e| e.1));
+                gaps.extend(row.drain(..).map(|e| e.0));
                 counts.push((list.len() - before) as u32);
             }
-            (counts, list)
+            (counts, list, gaps)
         })
         .collect();
     let mut offsets = Vec::with_capacity(x.len() + 1);
     offsets.push(0u32);
     let total: usize = rows.iter().map(|r| r.1.len()).sum();
     let mut nbr = Vec::with_capacity(total);
-    for (counts, list) in rows {
+    let mut gap = Vec::with_capacity(total);
+    for (counts, list, gaps) in rows {
         for c in counts {
             offsets.push(offsets.last().unwrap() + c);
         }
         nbr.extend_from_slice(&list);
+        gap.extend_from_slice(&gaps);
     }
-    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total] }
+    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total], gap }
 }
 
 impl NeighborList {

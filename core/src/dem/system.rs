@@ -21,8 +21,10 @@ pub struct DemSystem {
     pub(super) past: Past,
     /// Slot of `past` holding the newer values.
     ring: u8,
-    /// Positions at the last neighbour-list build.
+    /// Positions at the last neighbour-list build, and the largest displacement from them
+    /// since (over particles and steps).
     x_build: Vec<V3>,
+    max_disp: f64,
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
     pub(super) nl: NeighborList,
@@ -58,6 +60,7 @@ impl DemSystem {
             past: Past::zeros(n),
             ring: 0,
             x_build: Vec::new(),
+            max_disp: 0.0,
             ext: vec![[0.0; 3]; n],
             ids: (0..n as u32).collect(),
             nl: NeighborList::default(),
@@ -177,7 +180,8 @@ impl DemSystem {
             self.sc = Scratch::plan(&self.nl, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
+        let reach = self.reach();
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, reach);
         let st2 = if self.levels == 0 {
             self.heun::<FR>()
         } else {
@@ -198,6 +202,7 @@ impl DemSystem {
             st
         };
         let st = st1.max(st2);
+        self.max_disp = self.max_disp.max(st.disp2.sqrt());
         self.last = (st.overlap, st.coulomb_excess);
         if st.disp2 > 0.25 * self.p.skin * self.p.skin {
             self.rebuild_due = true;
@@ -222,7 +227,8 @@ impl DemSystem {
             self.v[i] = step(&v0[i], &d0[i][..3], h);
             self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
+        // The predictor's positions are not covered by `max_disp`: check every listed pair.
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, f64::INFINITY);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
         accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
         (self.nl.shear, self.nl.touch, self.walls) = (shear1, touch1, walls1);
@@ -248,6 +254,20 @@ impl DemSystem {
         Stats { disp2, ..st }
     }
 
+    /// Pairs with a gap at the list build above this cannot touch now: each partner moved at
+    /// most `max_disp`; the margin (1e-6 of the cutoff) covers the f32 rounding of the gaps.
+    fn reach(&self) -> f64 {
+        2.0 * self.max_disp + 1e-6 * self.p.cutoff
+    }
+
+    /// Replace the parameters mid-run (bed pouring stiffens the contacts in stages). The state
+    /// and contact histories stay; the multistep scheme restarts (Heun) for the new step.
+    pub(super) fn set_params(&mut self, p: DemParams) {
+        self.p = p;
+        self.levels = 0;
+        self.rebuild();
+    }
+
     /// Re-sort particles by linked cell, rebuild the half list, carry contact history by id.
     fn rebuild(&mut self) {
         let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
@@ -259,7 +279,7 @@ impl DemSystem {
         self.past.permute(&order);
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
-        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff);
+        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, 2.0 * self.p.radius);
         if self.p.friction {
             nl.carry_history(&self.nl, &old_ids, &self.ids);
         }
@@ -268,6 +288,7 @@ impl DemSystem {
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc = Scratch::default();
         self.x_build = self.x.clone();
+        self.max_disp = 0.0;
         self.rebuild_due = false;
     }
 }

@@ -98,3 +98,24 @@ fn generated_bed_is_cached_and_reproducible() {
     assert_eq!(a, c);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn settled_height_mode_fills_the_column_to_the_requested_height() {
+    // Height mode: pour enough particles, cut at H, relax. The bed top (highest particle top)
+    // must end within one diameter of H, and every particle inside the tube and above the plate.
+    let mut case = test_case(0.0192, 0.05, false, 9.81, 4e-6);
+    case.particles.youngs_modulus_pa = 1.2e7;
+    let d = case.particles.diameter_m;
+    let (r, rt, h) = (d / 2.0, case.column.diameter_m / 2.0, 0.008);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let (x, _) = pool.install(|| generate(&case, None, Some(h), 3, &mut |_| {})).unwrap();
+    let top = x.iter().map(|p| p[2] + r).fold(0.0, f64::max);
+    assert!((top - h).abs() <= d, "bed top {top} m, requested {h} m");
+    // A full column: the count is near φ π R_t² H / V_p for a random packing (φ ≈ 0.6).
+    let expect = 0.6 * std::f64::consts::PI * rt * rt * h / case.particle_volume_m3();
+    assert!((x.len() as f64 / expect - 1.0).abs() < 0.15, "{} particles, expected about {expect:.0}", x.len());
+    for p in &x {
+        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+        assert!(rho + r - rt < 0.02 * d && p[2] - r > -0.02 * d, "particle at {p:?} outside the tube");
+    }
+}
