@@ -34,6 +34,10 @@ const POUR_SOFTENING: f64 = 100.0;
 const POUR_E_FLOOR_RHO_V2: f64 = 1000.0;
 /// Extra viscous damping rate (1/s) while pouring and stiffening.
 const POUR_DAMPING: f64 = 20.0;
+/// Factor in E per stiffening stage after the pour.
+const STIFFEN_STEP: f64 = 3.1622776601683795; // √10
+/// Extra viscous damping rate (1/s) while stiffening (the bed is already jammed).
+const STIFFEN_DAMPING: f64 = 100.0;
 /// Pour step = Hertz contact time at 1 m/s over this.
 const POUR_STEPS_PER_CONTACT: f64 = 20.0;
 /// Settled when the mean kinetic energy per particle is below ½ m v² with this v (m/s).
@@ -108,12 +112,17 @@ pub fn generate(
         let (x, v) = (keep.iter().map(|&i| x[i]).collect(), keep.iter().map(|&i| sys.velocities()[i]).collect());
         sys = DemSystem::with_params(pour_params(case, e_pour, false), x, v);
     }
-    // Stiffen in steps of √10 in E, still damped, each until still.
+    // Stiffen in steps of STIFFEN_STEP in E, still damped, each until still.
     let mut e = e_pour;
     while e < e_real {
-        e = (e * 10f64.sqrt()).min(e_real);
-        sys.set_params(pour_params(case, e, e >= e_real));
-        settle(&mut sys, POUR_SPEED, observe)?;
+        e = (e * STIFFEN_STEP).min(e_real);
+        let last = e >= e_real;
+        let mut p = pour_params(case, e, last);
+        p.extra_damping = STIFFEN_DAMPING;
+        sys.set_params(p);
+        // The last stage settles to the final threshold while still damped (the case's own
+        // damping may be weak, e ≈ 0.97, and would ring for long).
+        settle(&mut sys, if last { RELAX_SPEED } else { POUR_SPEED }, observe)?;
     }
     // Final relaxation with the case's own parameters.
     let mut p = DemParams::new(case);
@@ -150,6 +159,9 @@ fn settle(sys: &mut DemSystem, speed: f64, observe: &mut dyn FnMut(&DemSystem)) 
         sys.step();
         observe(sys);
         if s % 200 == 0 && sys.kinetic_energy() < limit {
+            if std::env::var_os("FLUIDBED_POUR_TRACE").is_some() {
+                eprintln!("settle: {} particles, dt {:.3e}, {s} steps, {:.4} s", sys.len(), dt, s as f64 * dt);
+            }
             return Ok(());
         }
     }
