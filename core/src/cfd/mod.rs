@@ -13,6 +13,26 @@
 //! Heun → AB2 → AB3 in time (PHYSICS.md 7). `stable_dt` is the acoustic CFL limit inside AB3's
 //! region (stability.rs).
 //!
+//! Face mass flux (rhs.rs): ṁ = [½(m_a + m_b) + F]·|S| − (κ/a)ε_f|S|·m, with the pressure mismatch
+//! m = (p_b − p_a) − ½(∇p_a + ∇p_b)·d (zero for any linear p and, to O(dz³), for the hydrostatic
+//! state). Central fluxes alone leave an odd–even pressure mode: the weak κ = 0.05 dissipation
+//! damps it in time, but in a drag-dominated bed the steady state kept it (layer drops alternating
+//! ±69 % of the Beetstra value at ε = 0.727, ±90 % at ε = 0.4; cfd/tests/layer_pressure.rs).
+//! F is a momentum-interpolation (Rhie–Chow) correction carried as state on every face with its
+//! own equation, dF/dt = −s[ε_f m/δ + β_f F/(ρ_f ε_f)] (δ the centre distance, β = |I|/|u| per
+//! cell, face values the means): its steady value is the Darcy flux of the mismatch,
+//! F = −(ρ_f ε_f²/β_f)·m/δ, i.e. the face flux of the cells' drag balance u = −ε∇p/β, so the steady
+//! pressure of a bed is compact and ripple-free whatever the time step. Carried in time, F makes
+//! the odd–even mode a wave (as on a staggered grid) instead of a stiff pressure diffusion (the
+//! Darcy diffusivity ρa²ε/β, ~250 m²/s in a light bed, is far outside explicit reach):
+//! s = s₀/(1 + β_f δ/(ρ_f ε_f a)), s₀ = 0.1, keeps its frequency and its relaxation rate below
+//! a/δ; the central scheme's acoustic bound becomes a/√(1 − s₀) (stability.rs). F is antisymmetric
+//! per face (mass is conserved to round-off), vanishes in free stream and at rest, decays to zero in
+//! drag-free gas (β = 0: there κ alone handles the mode, which the characteristic outlet is tuned
+//! for: with F there the outlet reflected 1.7–1.9 % instead of 0.87 %), and is off on the face into
+//! the outlet layer. Where ε jumps from a bed to drag-free gas the layer pair at the jump is still
+//! off by a few per cent (the jump is resolved over one cell); the odd–even mode is gone.
+//!
 //! Boundaries:
 //! - Tube wall (r = R): full slip. No mass, momentum or viscous flux; the wall pressure is the
 //!   cell's own pressure (zero normal gradient), so it adds no force in the Green–Gauss sum.
@@ -23,9 +43,13 @@
 //!   central annulus; no flux uses it because the axis has no area.
 //! - Inlet (ghost layer below z = 0): vertical velocity U(t)/ε_inlet (interstitial; U(t) the
 //!   superficial velocity ramped linearly from 0 over gas.ramp_time_s), zero radial and angular
-//!   velocity. The ghost density is linearly extrapolated from the two layers above, so the face
-//!   density is ρ_f = (3ρ₀ − ρ₁)/2, the mass flux ρ_f·U(t)·A_z (i.e. ρ_f·ε_in·U/ε_in), its momentum
-//!   flux that times U(t)/ε_in, the face pressure a²ρ_f; no viscous flux. With U = 0 it is a wall.
+//!   velocity. The face pressure extrapolates p·exp(gz/a²) linearly from layers 0 and 1
+//!   (rhs.rs `inlet_face_pressure`: exact for the hydrostatic state and for a bed's linear drag
+//!   gradient, which the former hydrostatic ghost halved in layer 0), the face density ρ_f = p_f/a²,
+//!   the mass flux ρ_f·U(t)·A_z (i.e. ρ_f·ε_in·U/ε_in), its momentum flux that times U(t)/ε_in; no
+//!   viscous flux. With U = 0 it is a wall. An inlet voidage below the bed's adds the jet's momentum
+//!   flux ρU²(1/ε_in − 1/ε) to layer 0 (in a 0.727 bed fed at ε_in = 0.4: −6 % on the drop of
+//!   layers 0–1).
 //! - Outlet (top layer): the characteristic condition of eq. (5)–(7) with the typo mended
 //!   (PHYSICS.md 9). The top layer is not updated by fluxes: each step its momentum changes copy the
 //!   layer below (as changes of ρU, i.e. divided by that layer's ε and multiplied by its own), and
@@ -46,6 +70,7 @@ mod tests;
 pub use ab3::{ab2_weights, ab3_weights, AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
 pub use boundary::{outlet_density_change, ramped_superficial_velocity};
 pub use geometry::{horizontal_inverse_spacing, FaceGeometry, HFace, Neighbour};
+pub use rhs::FACE_FLUX_RATE;
 pub use smart::smart_face;
 pub use solver::{GasParams, GasSolver, Outlet};
 pub use stability::{case_stable_time_step, cell_stable_dt};

@@ -15,6 +15,8 @@
 //!   It vanishes for any linear pressure field and scales as κ a dz³∂⁴ρ on smooth waves; without it,
 //!   half the acoustic modes of a column with the characteristic outlet are undamped and the
 //!   linearly extrapolated inlet pressure makes some grow (semi-discrete eigenvalues; see the report);
+//! - plus the face correction F·|S| (state, one per face), the Rhie–Chow momentum interpolation whose
+//!   steady value is the Darcy flux of the same mismatch (cfd/mod.rs "Face mass flux");
 //! - stress ε∇·τ with τ = μ(∇u + ∇uᵀ) + (L − 2μ/3)(∇·u)I; for constant μ, ∇·τ = μ∇²u + (L + μ/3)∇(∇·u),
 //!   discretised as the compact face flux μ|S|/δ·(u_b − u_a) + (L + μ/3)·½(D_a + D_b)·S (eq. A.5–A.11).
 //! Sources: ρε g (−z) and the interaction force I (eq. A.12).
@@ -37,12 +39,15 @@ pub struct Primitives {
     pub gx: Vec<f64>,
     pub gy: Vec<f64>,
     pub gz: Vec<f64>,
+    /// Interphase coefficient per cell, β = |I|/|u| (0 without interaction force), for the face
+    /// mass-flux correction.
+    pub beta: Vec<f64>,
 }
 
 impl Primitives {
     pub fn new(n: usize) -> Primitives {
         let z = vec![0.0; n];
-        Primitives { ux: z.clone(), uy: z.clone(), uz: z.clone(), p: z.clone(), div: z.clone(), gx: z.clone(), gy: z.clone(), gz: z }
+        Primitives { ux: z.clone(), uy: z.clone(), uz: z.clone(), p: z.clone(), div: z.clone(), gx: z.clone(), gy: z.clone(), gz: z.clone(), beta: z }
     }
 }
 
@@ -56,6 +61,9 @@ pub struct RhsInput<'a> {
     pub eps: &'a [f64],
     /// Interaction force per unit volume, cylindrical (r, θ, z) in each cell's basis.
     pub force: &'a [[f64; 3]],
+    /// Face mass-flux corrections (kg m⁻² s⁻¹, module comment): the axial face above each cell
+    /// (n values; the top layer's unused), then each layer's horizontal faces (nz × faces).
+    pub face_flux: &'a [f64],
     pub time: f64,
 }
 
@@ -66,10 +74,17 @@ impl RhsInput<'_> {
         let u = ramped_superficial_velocity(p.superficial_velocity, p.ramp_time, self.time);
         (u / p.inlet_voidage, u)
     }
+    /// The horizontal-face corrections of layer k.
+    #[inline]
+    fn face_flux_h(&self, k: usize) -> &[f64] {
+        let (n, nf) = (self.per * self.nz, self.geo.faces.len());
+        &self.face_flux[n + k * nf..n + (k + 1) * nf]
+    }
 }
 
 /// Fill the primitive fields of one layer from the state.
-pub fn primitives_layer(inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64]) {
+#[allow(clippy::too_many_arguments)]
+pub fn primitives_layer(inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64], beta: &mut [f64]) {
     let a2 = inp.params.sound_speed * inp.params.sound_speed;
     let base = k * inp.per;
     for c in 0..inp.per {
@@ -80,17 +95,34 @@ pub fn primitives_layer(inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64]
         uz[c] = s[3] * inv;
         // Isothermal gas p = ρa², ρ = (ρε)/ε (PHYSICS.md 8).
         p[c] = a2 * s[0] / inp.eps[base + c];
+        // β = |I|/|u|: the drag coefficient when I = −β(u − v) and the particles are slow; only
+        // the relaxation of the face correction uses it (a floor of 1 µm/s on |u|).
+        let f = inp.force[base + c];
+        let fm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        let um = (ux[c] * ux[c] + uy[c] * uy[c] + uz[c] * uz[c]).sqrt();
+        beta[c] = if fm > 0.0 { fm / um.max(1e-6) } else { 0.0 };
     }
 }
 
 /// Coefficient κ of the pressure dissipation in the mass flux (module comment).
 pub const PRESSURE_DISSIPATION: f64 = 0.05;
 
-/// Pressure on the inlet face: the ghost layer below holds the density of layer 0 extrapolated
-/// hydrostatically, ρ_g = ρ₀·exp(g dz/a²), and the face takes the mean (p₀ + p_g)/2.
+/// Rate factor s₀ of the face mass-flux correction (module comment): it sets the frequency of the
+/// odd–even mode, ω ≤ 2a√s/δ, and raises the acoustic spectral radius of the central scheme to at
+/// most a/(δ√(1 − s₀)) (stability.rs); the steady state does not depend on it.
+pub const FACE_FLUX_RATE: f64 = 0.1;
+
+/// Pressure on the inlet face: p·exp(g z/a²) (constant in the hydrostatic state) extrapolated
+/// linearly from layers 0 and 1, φ_f = (3p₀ − p₁e)/2 with e = exp(g dz/a²), then p_f = φ_f·√e.
+/// Exact for the hydrostatic state and for a linear p (a bed's drag gradient, which a zero-gradient
+/// ghost would halve in layer 0). With a single layer the ghost is hydrostatic, p_f = p₀√e.
 #[inline]
-pub fn inlet_face_pressure(p0: f64, gravity: f64, dz: f64, a2: f64) -> f64 {
-    0.5 * p0 * (1.0 + (gravity * dz / a2).exp())
+pub fn inlet_face_pressure(p0: f64, p1: Option<f64>, gravity: f64, dz: f64, a2: f64) -> f64 {
+    let e = (gravity * dz / a2).exp();
+    match p1 {
+        Some(p1) => 0.5 * (3.0 * p0 - p1 * e) * e.sqrt(),
+        None => p0 * e.sqrt(),
+    }
 }
 
 /// Pressure on the top face: a shut top extrapolates hydrostatically as the inlet does; the
@@ -132,7 +164,7 @@ pub fn gradients_layer(inp: &RhsInput, pr: &Primitives, k: usize, div: &mut [f64
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
     for c in 0..per {
         let i = base + c;
-        let (w_bot, p_bot) = if k == 0 { (w_in, inlet_face_pressure(pr.p[i], par.gravity, inp.dz, a2)) } else { (0.5 * (pr.uz[i - per] + pr.uz[i]), 0.5 * (pr.p[i - per] + pr.p[i])) };
+        let (w_bot, p_bot) = if k == 0 { (w_in, inlet_face_pressure(pr.p[i], (inp.nz > 1).then(|| pr.p[i + per]), par.gravity, inp.dz, a2)) } else { (0.5 * (pr.uz[i - per] + pr.uz[i]), 0.5 * (pr.p[i - per] + pr.p[i])) };
         let (w_top, p_top) = if k + 1 < inp.nz {
             (0.5 * (pr.uz[i] + pr.uz[i + per]), 0.5 * (pr.p[i] + pr.p[i + per]))
         } else {
@@ -147,15 +179,39 @@ pub fn gradients_layer(inp: &RhsInput, pr: &Primitives, k: usize, div: &mut [f64
     }
 }
 
-/// Fluxes across the axial face between cell `lo` (layer kl) and the cell above it: the convective
-/// flux upward [ṁ, ṁu_x, ṁu_y, ṁu_z] and the viscous force on `lo`.
+/// Rate of change of one face's mass-flux correction F (module comment):
+/// dF/dt = −s·[ε_f·m/δ + β_f F/(ρ_f ε_f)], s = s₀/(1 + β_f δ/(ρ_f ε_f a)), m = (p_b − p_a) − ḡ·d.
+/// Its steady value is the Darcy flux of the mismatch, F = −(ρ_f ε_f²/β_f)·m/δ.
 #[inline]
-fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: usize) -> ([f64; 4], [f64; 3]) {
+fn face_flux_rate(eps_f: f64, rho_f: f64, beta_f: f64, mismatch: f64, delta: f64, f: f64, a: f64) -> f64 {
+    if beta_f <= 0.0 {
+        // Drag-free gas: no correction (the κ dissipation handles the mode, as the characteristic
+        // outlet expects); a correction left from earlier drag decays at s₀a/δ.
+        return -FACE_FLUX_RATE * a / delta * f;
+    }
+    let relax = beta_f / (rho_f * eps_f);
+    let s = FACE_FLUX_RATE / (1.0 + relax * delta / a);
+    -s * (eps_f * mismatch / delta + relax * f)
+}
+
+/// Fluxes across the axial face between cell `lo` (layer kl) and the cell above it: the convective
+/// flux upward [ṁ, ṁu_x, ṁu_y, ṁu_z], the viscous force on `lo` and dF/dt of the face.
+#[inline]
+fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: usize) -> ([f64; 4], [f64; 3], f64) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let hi = lo + per;
     let az = geo.area_z;
-    let diss = PRESSURE_DISSIPATION / par.sound_speed * 0.5 * (inp.eps[lo] + inp.eps[hi]) * az * ((pr.p[hi] - pr.p[lo]) - 0.5 * (pr.gz[lo] + pr.gz[hi]) * inp.dz);
-    let mflux = 0.5 * (q[lo][3] + q[hi][3]) * az - diss;
+    let eps_f = 0.5 * (inp.eps[lo] + inp.eps[hi]);
+    let mismatch = (pr.p[hi] - pr.p[lo]) - 0.5 * (pr.gz[lo] + pr.gz[hi]) * inp.dz;
+    let diss = PRESSURE_DISSIPATION / par.sound_speed * eps_f * az * mismatch;
+    // The face into the characteristic outlet layer carries no correction: that layer follows
+    // eq. (5)–(7), and a correction there reflects outgoing waves (2 % instead of 0.9 %).
+    let corrected = !(kl + 2 == inp.nz && par.outlet == Outlet::Characteristic);
+    let ff = if corrected { inp.face_flux[lo] } else { 0.0 };
+    let mflux = (0.5 * (q[lo][3] + q[hi][3]) + ff) * az - diss;
+    let a = par.sound_speed;
+    let rho_f = 0.5 * (pr.p[lo] + pr.p[hi]) / (a * a);
+    let dff = if corrected { face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[lo] + pr.beta[hi]), mismatch, inp.dz, ff, a) } else { 0.0 };
     // Upwind cell C, its upwind U (None at the ends: first-order upwind) and downwind D.
     let (c, u, d) = if mflux >= 0.0 { (lo, if kl >= 1 { Some(lo - per) } else { None }, hi) } else { (hi, if kl + 2 < inp.nz { Some(hi + per) } else { None }, lo) };
     let face = |v: &[f64]| match u {
@@ -166,16 +222,20 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: us
     let m = par.viscosity * az / inp.dz;
     let lam = (par.bulk_viscosity + par.viscosity / 3.0) * 0.5 * (pr.div[lo] + pr.div[hi]) * az;
     let visc = [m * (pr.ux[hi] - pr.ux[lo]), m * (pr.uy[hi] - pr.uy[lo]), m * (pr.uz[hi] - pr.uz[lo]) + lam];
-    (conv, visc)
+    (conv, visc, dff)
 }
 
-/// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long).
-pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize, out: &mut [[f64; 4]]) {
+/// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
+/// layer's face corrections: the axial faces above its cells into `out_fz` (one layer long, zero
+/// for the top layer), its horizontal faces into `out_fh`.
+pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize, out: &mut [[f64; 4]], out_fz: &mut [f64], out_fh: &mut [f64]) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let base = k * per;
+    out_fz.iter_mut().for_each(|r| *r = 0.0);
     if k + 1 == inp.nz && par.outlet == Outlet::Characteristic && inp.nz > 1 {
         // The outlet layer follows eq. (5)–(7) instead of the fluxes (solver.rs).
         out.iter_mut().for_each(|r| *r = [0.0; 4]);
+        out_fh.iter_mut().for_each(|r| *r = 0.0);
         return;
     }
     // Sources: interaction force (cylindrical → Cartesian), gravity ρεg, pressure −ε∇p.
@@ -189,12 +249,18 @@ pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize,
     let inv_v = 1.0 / geo.volume;
     let lam_coef = par.bulk_viscosity + par.viscosity / 3.0;
     let kappa_a = PRESSURE_DISSIPATION / par.sound_speed;
+    let a2 = par.sound_speed * par.sound_speed;
+    let ff_h = inp.face_flux_h(k);
     // Horizontal faces (central in r and θ).
-    for f in &geo.faces {
+    for (n, f) in geo.faces.iter().enumerate() {
         let (la, lb) = (f.a as usize, f.b as usize);
         let (a, b) = (base + la, base + lb);
-        let diss = kappa_a * 0.5 * (inp.eps[a] + inp.eps[b]) * f.s_abs * ((pr.p[b] - pr.p[a]) - 0.5 * ((pr.gx[a] + pr.gx[b]) * f.dx + (pr.gy[a] + pr.gy[b]) * f.dy));
-        let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) - diss;
+        let eps_f = 0.5 * (inp.eps[a] + inp.eps[b]);
+        let mismatch = (pr.p[b] - pr.p[a]) - 0.5 * ((pr.gx[a] + pr.gx[b]) * f.dx + (pr.gy[a] + pr.gy[b]) * f.dy);
+        let diss = kappa_a * eps_f * f.s_abs * mismatch;
+        let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) + ff_h[n] * f.s_abs - diss;
+        let rho_f = 0.5 * (pr.p[a] + pr.p[b]) / a2;
+        out_fh[n] = face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[a] + pr.beta[b]), mismatch, f.dx.hypot(f.dy), ff_h[n], par.sound_speed);
         let h = 0.5 * mflux * inv_v;
         let conv = [mflux * inv_v, h * (pr.ux[a] + pr.ux[b]), h * (pr.uy[a] + pr.uy[b]), h * (pr.uz[a] + pr.uz[b])];
         let m = par.viscosity * f.area_over_delta * inv_v;
@@ -214,7 +280,6 @@ pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize,
     }
     // Axial faces: bottom and top of this layer (each computed identically by both layers).
     let (w_in, u_in) = inp.inlet();
-    let a2 = par.sound_speed * par.sound_speed;
     for c in 0..per {
         let i = base + c;
         let e = inp.eps[i] * inv_v;
@@ -222,12 +287,12 @@ pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize,
         if k == 0 {
             // Inlet: ṁ = ρ_f·U(t)·A_z with the face density of the hydrostatic ghost, momentum
             // flux ṁ·U(t)/ε_in (vertical only), no viscous flux.
-            let rho_f = inlet_face_pressure(pr.p[i], par.gravity, inp.dz, a2) / a2;
+            let rho_f = inlet_face_pressure(pr.p[i], (inp.nz > 1).then(|| pr.p[i + per]), par.gravity, inp.dz, a2) / a2;
             let m_in = rho_f * u_in * geo.area_z;
             r[0] += m_in * inv_v;
             r[3] += m_in * w_in * inv_v;
         } else {
-            let (conv, visc) = axial_face(inp, q, pr, k - 1, i - per);
+            let (conv, visc, _) = axial_face(inp, q, pr, k - 1, i - per);
             for n in 0..4 {
                 r[n] += conv[n] * inv_v;
             }
@@ -236,7 +301,8 @@ pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize,
             }
         }
         if k + 1 < inp.nz {
-            let (conv, visc) = axial_face(inp, q, pr, k, i);
+            let (conv, visc, dff) = axial_face(inp, q, pr, k, i);
+            out_fz[c] = dff;
             for n in 0..4 {
                 r[n] -= conv[n] * inv_v;
             }

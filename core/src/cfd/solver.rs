@@ -1,7 +1,7 @@
 //! `GasSolver`: state, time stepping (Heun → AB2 → AB3, PHYSICS.md 7) and the public API the
 //! coupled simulation calls. Boundary and axis decisions are documented in cfd/mod.rs.
 
-use super::ab3::{ab2_weights, ab3_weights};
+use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::outlet_density_change;
 use super::geometry::FaceGeometry;
 use super::rhs::{gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives, RhsInput};
@@ -62,6 +62,13 @@ struct State {
     hist_h: [f64; 2],
     hist_len: usize,
     head: usize,
+    /// Face mass-flux corrections F (rhs.rs, cfd/mod.rs): the axial face above each cell, then each
+    /// layer's horizontal faces; and their right-hand sides of earlier steps (same ring as `hist`).
+    /// Older checkpoints without them restart F from zero.
+    #[serde(default)]
+    face_flux: Vec<f64>,
+    #[serde(default)]
+    hist_face: [Vec<f64>; 3],
 }
 
 /// The volume-averaged compressible gas (paper section 2.2 and Appendix A).
@@ -73,6 +80,8 @@ pub struct GasSolver {
     prim: Primitives,
     q_old: Vec<[f64; 4]>,
     stage: Vec<[f64; 4]>,
+    face_old: Vec<f64>,
+    face_stage: Vec<f64>,
     parallel: bool,
 }
 
@@ -99,7 +108,7 @@ impl GasSolver {
         };
         let n = grid.num_cells();
         let spec = GridSpec { radius: grid.radius, height: grid.height, dr: grid.dr, dz: grid.dz, n0: grid.n0 };
-        let st = State { grid: spec, params, time: 0.0, steps: 0, q: vec![[0.0; 4]; n], eps: vec![1.0; n], force: vec![[0.0; 3]; n], hist: [vec![[0.0; 4]; n], vec![[0.0; 4]; n], vec![[0.0; 4]; n]], hist_h: [0.0; 2], hist_len: 0, head: 0 };
+        let st = State { grid: spec, params, time: 0.0, steps: 0, q: vec![[0.0; 4]; n], eps: vec![1.0; n], force: vec![[0.0; 3]; n], hist: [vec![[0.0; 4]; n], vec![[0.0; 4]; n], vec![[0.0; 4]; n]], hist_h: [0.0; 2], hist_len: 0, head: 0, face_flux: Vec::new(), hist_face: Default::default() };
         let mut s = GasSolver::from_state(st, grid);
         for c in 0..n {
             let rho = s.hydrostatic_density(c);
@@ -108,10 +117,15 @@ impl GasSolver {
         s
     }
 
-    fn from_state(st: State, grid: CylGrid) -> GasSolver {
+    fn from_state(mut st: State, grid: CylGrid) -> GasSolver {
         let n = grid.num_cells();
         let geo = FaceGeometry::new(&grid);
-        GasSolver { st, geo, prim: Primitives::new(n), q_old: vec![[0.0; 4]; n], stage: vec![[0.0; 4]; n], parallel: n >= PARALLEL_MIN_CELLS, grid }
+        let nf = n + grid.nz * geo.faces.len();
+        if st.face_flux.len() != nf || st.hist_face.iter().any(|h| h.len() != nf) {
+            st.face_flux = vec![0.0; nf];
+            st.hist_face = [vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]];
+        }
+        GasSolver { st, geo, prim: Primitives::new(n), q_old: vec![[0.0; 4]; n], stage: vec![[0.0; 4]; n], face_old: vec![0.0; nf], face_stage: vec![0.0; nf], parallel: n >= PARALLEL_MIN_CELLS, grid }
     }
 
     /// ρ(z) = (p_out/a²)·exp(g(H − z)/a²) at the centre of cell c (PHYSICS.md 8).
@@ -236,7 +250,7 @@ impl GasSolver {
         }
         let (nz, par) = (self.grid.nz, &self.st.params);
         let a2 = par.sound_speed * par.sound_speed;
-        let p_bot = if k == 0 { inlet_face_pressure(pc, par.gravity, self.grid.dz, a2) } else { 0.5 * (pc + self.pressure_at(cell - per)) };
+        let p_bot = if k == 0 { inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, self.grid.dz, a2) } else { 0.5 * (pc + self.pressure_at(cell - per)) };
         let p_top = if k + 1 < nz {
             0.5 * (pc + self.pressure_at(cell + per))
         } else {
@@ -286,43 +300,51 @@ impl GasSolver {
     }
 
     /// Advance by dt: Heun for the first step, then AB2, then AB3 with variable-step weights.
+    /// The face corrections F are integrated with the cell state by the same scheme.
     pub fn step(&mut self, dt: f64) {
         let t = self.st.time;
         self.q_old.copy_from_slice(&self.st.q);
+        self.face_old.copy_from_slice(&self.st.face_flux);
         let newest = (self.st.head + 1) % 3;
         let mut f_new = std::mem::take(&mut self.st.hist[newest]);
-        self.rhs_into(t, &mut f_new);
+        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        self.rhs_into(t, &mut f_new, &mut g_new);
         let hl = self.st.hist_len;
         let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
         {
-            let (q, q0) = (&mut self.st.q, &self.q_old);
+            let (q, q0) = (self.st.q.as_flattened_mut(), self.q_old.as_flattened());
+            let (ff, ff0) = (&mut self.st.face_flux, &self.face_old);
             match hl {
                 0 => {
                     // Heun predictor.
-                    q.iter_mut().zip(q0).zip(&f_new).for_each(|((y, y0), f)| (0..4).for_each(|n| y[n] = y0[n] + dt * f[n]));
+                    combine(q, q0, &[f_new.as_flattened()], &[dt]);
+                    combine(ff, ff0, &[&g_new], &[dt]);
                 }
                 1 => {
-                    let b = ab2_weights(dt, h1);
-                    let f1 = &self.st.hist[self.st.head];
-                    q.iter_mut().zip(q0).zip(f_new.iter().zip(f1)).for_each(|((y, y0), (f, g))| (0..4).for_each(|n| y[n] = y0[n] + dt * (b[0] * f[n] + b[1] * g[n])));
+                    let b = ab2_weights(dt, h1).map(|w| w * dt);
+                    combine(q, q0, &[f_new.as_flattened(), self.st.hist[i1].as_flattened()], &b);
+                    combine(ff, ff0, &[&g_new, &self.st.hist_face[i1]], &b);
                 }
                 _ => {
-                    let b = ab3_weights(dt, h1, h2);
-                    let (f1, f2) = (&self.st.hist[self.st.head], &self.st.hist[(self.st.head + 2) % 3]);
-                    q.iter_mut().zip(q0).zip(f_new.iter().zip(f1.iter().zip(f2))).for_each(|((y, y0), (f, (g, h)))| (0..4).for_each(|n| y[n] = y0[n] + dt * (b[0] * f[n] + b[1] * g[n] + b[2] * h[n])));
+                    let b = ab3_weights(dt, h1, h2).map(|w| w * dt);
+                    combine(q, q0, &[f_new.as_flattened(), self.st.hist[i1].as_flattened(), self.st.hist[i2].as_flattened()], &b);
+                    combine(ff, ff0, &[&g_new, &self.st.hist_face[i1], &self.st.hist_face[i2]], &b);
                 }
             }
         }
         self.apply_outlet(dt);
         if hl == 0 {
             // Heun corrector: y1 = y0 + h/2 (f(y0) + f(y*)).
-            let mut stage = std::mem::take(&mut self.stage);
-            self.rhs_into(t + dt, &mut stage);
-            self.st.q.iter_mut().zip(&self.q_old).zip(f_new.iter().zip(&stage)).for_each(|((y, y0), (f, g))| (0..4).for_each(|n| y[n] = y0[n] + 0.5 * dt * (f[n] + g[n])));
-            self.stage = stage;
+            let (mut stage, mut face_stage) = (std::mem::take(&mut self.stage), std::mem::take(&mut self.face_stage));
+            self.rhs_into(t + dt, &mut stage, &mut face_stage);
+            combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &[f_new.as_flattened(), stage.as_flattened()], &[0.5 * dt, 0.5 * dt]);
+            combine(&mut self.st.face_flux, &self.face_old, &[&g_new, &face_stage], &[0.5 * dt, 0.5 * dt]);
+            (self.stage, self.face_stage) = (stage, face_stage);
             self.apply_outlet(dt);
         }
         self.st.hist[newest] = f_new;
+        self.st.hist_face[newest] = g_new;
         self.st.head = newest;
         self.st.hist_h = [dt, h1];
         self.st.hist_len = (hl + 1).min(3);
@@ -357,28 +379,33 @@ impl GasSolver {
         }
     }
 
-    /// Right-hand side of the current state `self.st.q` at time t into `out`.
-    fn rhs_into(&mut self, t: f64, out: &mut [[f64; 4]]) {
+    /// Right-hand sides of the current state (`self.st.q` into `out`, the face corrections into
+    /// `out_face`) at time t.
+    fn rhs_into(&mut self, t: f64, out: &mut [[f64; 4]], out_face: &mut [f64]) {
         let per = self.grid.cells_per_layer();
-        let inp = RhsInput { geo: &self.geo, params: &self.st.params, per, nz: self.grid.nz, dz: self.grid.dz, eps: &self.st.eps, force: &self.st.force, time: t };
+        let nf = self.geo.faces.len().max(1);
+        let inp = RhsInput { geo: &self.geo, params: &self.st.params, per, nz: self.grid.nz, dz: self.grid.dz, eps: &self.st.eps, force: &self.st.force, face_flux: &self.st.face_flux, time: t };
         let q = &self.st.q;
         let pr = &mut self.prim;
+        let (out_fz, out_fh) = out_face.split_at_mut(q.len());
         if self.parallel {
-            pr.ux.par_chunks_mut(per).zip(pr.uy.par_chunks_mut(per)).zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per))).enumerate().for_each(|(k, ((ux, uy), (uz, p)))| primitives_layer(&inp, q, k, ux, uy, uz, p));
+            let beta = &mut pr.beta;
+            pr.ux.par_chunks_mut(per).zip(pr.uy.par_chunks_mut(per)).zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per))).zip(beta.par_chunks_mut(per)).enumerate().for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
             let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
             let prr = &*pr;
             div.par_chunks_mut(per).zip(gx.par_chunks_mut(per)).zip(gy.par_chunks_mut(per).zip(gz.par_chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
             (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
             let pr = &*pr;
-            out.par_chunks_mut(per).enumerate().for_each(|(k, o)| residual_layer(&inp, q, pr, k, o));
+            out.par_chunks_mut(per).zip(out_fz.par_chunks_mut(per).zip(out_fh.par_chunks_mut(nf))).enumerate().for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
         } else {
-            pr.ux.chunks_mut(per).zip(pr.uy.chunks_mut(per)).zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per))).enumerate().for_each(|(k, ((ux, uy), (uz, p)))| primitives_layer(&inp, q, k, ux, uy, uz, p));
+            let beta = &mut pr.beta;
+            pr.ux.chunks_mut(per).zip(pr.uy.chunks_mut(per)).zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per))).zip(beta.chunks_mut(per)).enumerate().for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
             let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
             let prr = &*pr;
             div.chunks_mut(per).zip(gx.chunks_mut(per)).zip(gy.chunks_mut(per).zip(gz.chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
             (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
             let pr = &*pr;
-            out.chunks_mut(per).enumerate().for_each(|(k, o)| residual_layer(&inp, q, pr, k, o));
+            out.chunks_mut(per).zip(out_fz.chunks_mut(per).zip(out_fh.chunks_mut(nf))).enumerate().for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
         }
     }
 }

@@ -2,13 +2,16 @@
 //! (PHYSICS.md 7: |λh| ≤ 0.7236 on the imaginary axis, ≥ −6/11 on the negative real axis).
 //!
 //! Convective/acoustic spectral radius of a cell (central fluxes; Blazek's estimate ½Σ(|u·n|+a)|S|/V):
-//!   λ_c = (|u_h| + a)·(1 + n0/π)/dr + (|u_z| + a)/dz     (geometry::horizontal_inverse_spacing)
+//!   λ_c = (|u_h| + a')·(1 + n0/π)/dr + (|u_z| + a')/dz     (geometry::horizontal_inverse_spacing)
+//! with a' = a/√(1 − s₀): the face mass-flux correction (rhs.rs, s₀ = FACE_FLUX_RATE) gives a wave
+//! of number θ = kδ the frequency² (a/δ)²[sin²θ + 4s₀ sin⁴(θ/2)], at most (a/δ)²/(1 − s₀) for s₀ ≤ ½.
 //! Viscous spectral radius of the compact Laplacian with ν = (4μ/3 + L)/ρ:
 //!   λ_v = 2ν·max_c Σ_f (|S_f|/δ_f)/V
 //! and dt = cfl·1/(λ_c/0.7236 + λ_v/(6/11)), the min over cells.
 
 use super::ab3::{AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
 use super::geometry::{horizontal_inverse_spacing, FaceGeometry};
+use super::rhs::FACE_FLUX_RATE;
 use crate::case::Case;
 use crate::grid::CylGrid;
 
@@ -16,6 +19,7 @@ use crate::grid::CylGrid;
 #[allow(clippy::too_many_arguments)]
 #[inline]
 pub fn cell_stable_dt(u_h: f64, u_z: f64, a: f64, nu: f64, dr: f64, dz: f64, n0: usize, laplacian_factor: f64, cfl: f64) -> f64 {
+    let a = a / (1.0 - FACE_FLUX_RATE).sqrt();
     let lam_c = (u_h + a) * horizontal_inverse_spacing(dr, n0) + (u_z + a) / dz;
     let lam_v = 2.0 * nu * laplacian_factor;
     cfl / (lam_c / AB3_IMAGINARY_LIMIT + lam_v / AB3_REAL_LIMIT)

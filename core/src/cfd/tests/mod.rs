@@ -3,6 +3,7 @@
 mod acoustics;
 mod conservation;
 mod hydrostatic;
+mod layer_pressure;
 mod porous_zone;
 mod support;
 mod validation;
