@@ -46,7 +46,8 @@ pub fn run() -> serde_json::Value {
         let uz: Vec<f64> = s.gas_velocity_m_s.as_ref().unwrap().iter().map(|v| v[2]).collect();
         let eps = s.voidage.clone().unwrap();
         let top = bed_top_m(&sim);
-        let k_bed = ((top - sim.case().particles.diameter_m) / s.grid.dz_m).floor() as usize;
+        // the highest layer wholly inside the bed
+        let k_bed = ((top - sim.case().particles.diameter_m) / s.grid.dz_m).floor() as usize - 1;
         let r = roughness(s, &uz, k_bed);
         let (_, mean_eps) = gradient_and_voidage(s, 1, k_bed);
         eprintln!("{name}: bed voidage {mean_eps:.4}, U_z roughness {r:.3}");

@@ -1,6 +1,6 @@
 //! Packed bed (issue: coupling): frozen particles, U = 0.15, 0.20, 0.25 m/s. ΔP/L across the
 //! bed must be within 3% of the Beetstra-implied value at the bed's measured mean voidage
-//! (PHYSICS.md 11) and within 10% of Ergun (PHYSICS.md 10).
+//! (PHYSICS.md 11) and within 10% of Ergun (PHYSICS.md 10), each plus the gas head ρ_g g.
 
 use crate::common::*;
 use serde_json::json;
@@ -27,13 +27,15 @@ pub fn run(small: bool) -> serde_json::Value {
         let s = snaps.last().unwrap();
         let top = bed_top_m(&sim);
         let dz = s.grid.dz_m;
-        // Layers whose centres lie inside the bed, away from the plate and the surface.
-        let (k1, k2) = (1usize, ((top - d) / dz - 0.5).floor() as usize);
+        // Layers wholly inside the bed (top at least d below the surface), away from the plate.
+        let (k1, k2) = (1usize, ((top - d) / dz).floor() as usize - 1);
         assert!(k2 > k1, "bed too shallow for the grid");
         let (grad, eps) = gradient_and_voidage(s, k1, k2);
         let rho = layers(s, &s.pressure_pa.clone().unwrap())[k1] / sim.case().gas.as_ref().unwrap().sound_speed_m_s().powi(2);
-        let want = beetstra_gradient(eps, u, d, mu, rho);
-        let erg = ergun(eps, u, d, mu, rho);
+        // the gas's own weight adds ρ_g g to the gradient (model A, PHYSICS.md 11)
+        let gas_head = rho * sim.case().gravity_m_s2;
+        let want = beetstra_gradient(eps, u, d, mu, rho) + gas_head;
+        let erg = ergun(eps, u, d, mu, rho) + gas_head;
         let (e_b, e_e) = (grad / want - 1.0, grad / erg - 1.0);
         // The previous snapshot shows whether the flow is steady.
         let prev = &snaps[snaps.len() - 2];

@@ -55,7 +55,8 @@ fn small_packed_bed_matches_beetstra_at_its_voidage() {
     let (mu, d) = (1.8e-5, 0.0012);
     let rho = p[k1] / sim.case().gas.as_ref().unwrap().sound_speed_m_s().powi(2);
     let re = rho * u * d / mu;
-    let want = 18.0 * mu * (1.0 - eps) * crate::coupling::beetstra_f(eps, re) * u / (eps * d * d);
+    // model A's gradient plus the gas head ρ_g g
+    let want = 18.0 * mu * (1.0 - eps) * crate::coupling::beetstra_f(eps, re) * u / (eps * d * d) + rho * 9.81;
     assert!((grad / want - 1.0).abs() < 0.03, "ΔP/L {grad:.1} Pa/m vs Beetstra {want:.1} at ε = {eps:.4}");
 }
 
