@@ -189,6 +189,11 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mu
 #[inline(always)]
 fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     let &ChunkArgs { law, r, h, d2, reach, a, b, offsets, nbr, gap, x, v, w } = c;
+    // Compared in f32: rounding `reach` up keeps the test conservative.
+    let reach = {
+        let q = reach as f32;
+        if (q as f64) < reach { f32::from_bits(q.to_bits() + 1) } else { q }
+    };
     acc.fill([0.0; 6]);
     let mut st = Stats::ZERO;
     let base = offsets[a] as usize;
@@ -197,11 +202,11 @@ fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc:
     let mut m = 0;
     for i in a..b {
         let xi = x[i];
-        let (k0, mut k1) = (offsets[i] as usize, offsets[i + 1] as usize);
-        if let Some(stop) = gap[k0..k1].iter().position(|&g| g as f64 > reach) {
-            k1 = k0 + stop;
-        }
-        for (k, &j) in (k0..k1).zip(&nbr[k0..k1]) {
+        let (k0, k1) = (offsets[i] as usize, offsets[i + 1] as usize);
+        for ((k, &j), &g) in (k0..k1).zip(&nbr[k0..k1]).zip(&gap[k0..k1]) {
+            if g > reach {
+                break; // the rest of the row is farther still
+            }
             let j = j as usize;
             // SAFETY: `Scratch::plan` checked i < j < x.len() for every listed pair, and the
             // chunk's `to` covers its rows' entries k0 - base .. k1 - base.
