@@ -2,19 +2,17 @@
 //! 1. pair pass: every listed pair once (half list), contiguous particle chunks in parallel, each
 //!    adding the pair forces on i and j into its own buffer (no atomics, no races); a listed pair
 //!    costs a distance check, only touching pairs go to the batched contact kernel;
-//! 2. particle pass (`update`): per block, sum the chunk buffers in chunk order, add walls (only
-//!    for the wall list), gravity and the external force, and advance by AB3.
+//! 2. the particle pass (`particle_pass`): per block, sum the chunk buffers in chunk order, add
+//!    walls (only for the wall list), gravity and the external force, and advance by AB3.
+//!
+//! This file holds the shared types and pass 1.
 
 use super::pair_batch::{Batch, CAP};
 use super::contact::{ContactLaw, V3};
 use super::neighbors::NeighborList;
-use super::walls::{wall_forces, WallList};
 use super::DemParams;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-
-/// Particles per block of the particle pass (fixed, so results do not depend on threads).
-pub const BLOCK: usize = 256;
 
 /// Force and n × F_t sums of one particle.
 pub type Acc = [f64; 6];
@@ -261,196 +259,4 @@ fn flush<const FR: bool>(
         }
     }
     batch.m = 0;
-}
-
-/// Accelerations (a, α) of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices): the
-/// external force, then the chunk buffers in chunk order, walls for the wall-list entries
-/// `widx`/`whist`, gravity and the pour's extra damping.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn block_accel<const FR: bool>(
-    p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: &Scratch, widx: &[u32],
-    whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
-) {
-    let hi = lo + out.len();
-    for (o, e) in out.iter_mut().zip(&ext[lo..hi]) {
-        *o = [e[0], e[1], e[2], 0.0, 0.0, 0.0];
-    }
-    for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
-        let (s, t) = (lo.max(a), hi.min(e));
-        if s < t {
-            let buf = &sc.acc[sc.start[c] + s - a..sc.start[c] + t - a];
-            for (o, q) in out[s - lo..t - lo].iter_mut().zip(buf) {
-                for k in 0..6 {
-                    o[k] += q[k];
-                }
-            }
-        }
-    }
-    for (&i, hist) in widx.iter().zip(whist.iter_mut()) {
-        let l = i as usize - lo;
-        let (ov, ex) = wall_forces::<FR>(p, x[l], v[l], w[l], hist, &mut out[l]);
-        st.overlap = st.overlap.max(ov);
-        st.coulomb_excess = st.coulomb_excess.max(ex);
-    }
-    // a = F/m − g e_z − γ v, α = R (Σ n × F_t)/I − γ ω.
-    let (r, im, g, gz) = (p.radius, 1.0 / p.mass, p.extra_damping, p.gravity);
-    let ii = r / p.inertia;
-    for ((o, vi), wi) in out.iter_mut().zip(v).zip(w) {
-        let a = [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]];
-        let alpha = if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] };
-        *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
-    }
-}
-
-/// Wall-list entries split by block, for handing each block its own histories.
-fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> {
-    let mut out = Vec::with_capacity(n.div_ceil(BLOCK));
-    let (mut idx, mut hist) = (&walls.idx[..], &mut walls.hist[..]);
-    for b in 0..n.div_ceil(BLOCK) {
-        let hi = ((b + 1) * BLOCK).min(n);
-        let k = idx.partition_point(|&i| (i as usize) < hi);
-        let (i0, i1) = idx.split_at(k);
-        let (h0, h1) = std::mem::take(&mut hist).split_at_mut(k);
-        out.push((i0, h0));
-        (idx, hist) = (i1, h1);
-    }
-    out
-}
-
-/// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
-#[allow(clippy::too_many_arguments)]
-pub fn accel_pass<const FR: bool>(
-    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], walls: &mut WallList, ext: &[V3], sc: &Scratch, out: &mut [Acc],
-) -> Stats {
-    let wb = wall_blocks(walls, x.len());
-    out.par_chunks_mut(BLOCK)
-        .zip(wb)
-        .enumerate()
-        .map(|(b, (ob, (widx, whist)))| {
-            let mut st = Stats::ZERO;
-            let r = b * BLOCK..b * BLOCK + ob.len();
-            block_accel::<FR>(p, r.start, &x[r.clone()], &v[r.clone()], &w[r], ext, sc, widx, whist, ob, &mut st);
-            st
-        })
-        .reduce(|| Stats::ZERO, Stats::max)
-}
-
-/// Mutable per-particle state of the particle pass.
-pub struct Motion<'a> {
-    pub x: &'a mut [V3],
-    pub v: &'a mut [V3],
-    pub w: &'a mut [V3],
-    pub past: &'a mut Past,
-    pub x_build: &'a [V3],
-    pub walls: &'a mut WallList,
-}
-
-/// One block's share of `Motion`; `older` slots are overwritten with the current derivatives.
-struct BlockMotion<'a> {
-    lo: usize,
-    x: &'a mut [V3],
-    v: &'a mut [V3],
-    w: &'a mut [V3],
-    newer: [&'a [V3]; 3],
-    older: [&'a mut [V3]; 3],
-    widx: &'a [u32],
-    whist: &'a mut [[V3; 3]],
-}
-
-/// Pass 2, fused: accelerations and the multistep update (weights `hb` = h·b; slot `ring` of
-/// `past` holds the newer values, the current derivative overwrites the other) in one sweep.
-pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: Motion, ext: &[V3], sc: &Scratch) -> Stats {
-    let n = m.x.len();
-    let older = 1 - ring;
-    let mut wb = wall_blocks(m.walls, n).into_iter();
-    let [pv, pa, pw] = [&mut m.past.v, &mut m.past.a, &mut m.past.alpha].map(|s| {
-        let (s0, s1) = s.split_at_mut(1);
-        let (s0, s1) = (&mut s0[0][..], &mut s1[0][..]);
-        if older == 0 {
-            (s1.chunks(BLOCK), s0.chunks_mut(BLOCK))
-        } else {
-            (s0.chunks(BLOCK), s1.chunks_mut(BLOCK))
-        }
-    });
-    let (mut nv, mut ov) = pv;
-    let (mut na, mut oa) = pa;
-    let (mut nw, mut ow) = pw;
-    let mut work = Vec::with_capacity(n.div_ceil(BLOCK));
-    for (b, ((x, v), w)) in m.x.chunks_mut(BLOCK).zip(m.v.chunks_mut(BLOCK)).zip(m.w.chunks_mut(BLOCK)).enumerate() {
-        let (widx, whist) = wb.next().expect("wall block");
-        let mut nx = || (nv.next().unwrap(), na.next().unwrap(), nw.next().unwrap());
-        let (a0, a1, a2) = nx();
-        let older = [ov.next().unwrap(), oa.next().unwrap(), ow.next().unwrap()];
-        work.push(BlockMotion { lo: b * BLOCK, x, v, w, newer: [a0, a1, a2], older, widx, whist });
-    }
-    let x_build = m.x_build;
-    work.into_par_iter()
-        .map(|bm| update_block_dispatch::<FR>(p, hb, bm, x_build, ext, sc))
-        .reduce(|| Stats::ZERO, Stats::max)
-}
-
-fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports the features the function is compiled for.
-            return unsafe { update_block_avx512::<FR>(p, hb, bm, xb, ext, sc) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: as above.
-            return unsafe { update_block_avx2::<FR>(p, hb, bm, xb, ext, sc) };
-        }
-    }
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn update_block_avx512<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-/// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), then f_older ← f (flat arrays, vectorised).
-#[inline(always)]
-fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
-    for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
-        *y += hb[0] * f + hb[1] * f1 + hb[2] * *f2;
-        *f2 = f;
-    }
-}
-
-#[inline(always)]
-fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_build: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
-    let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
-    let len = x.len();
-    let mut st = Stats::ZERO;
-    let mut acc = [[0.0; 6]; BLOCK];
-    let acc = &mut acc[..len];
-    block_accel::<FR>(p, lo, x, v, w, ext, sc, widx, whist, acc, &mut st);
-    let mut a = [[0.0; 3]; BLOCK];
-    let mut al = [[0.0; 3]; BLOCK];
-    for ((o, a), al) in acc.iter().zip(&mut a[..len]).zip(&mut al[..len]) {
-        *a = [o[0], o[1], o[2]];
-        *al = [o[3], o[4], o[5]];
-    }
-    let [ov, oa, ow] = older;
-    // x first: it uses the old velocities.
-    let vel: &[f64] = v.as_flattened();
-    ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
-    ab_flat(hb, v.as_flattened_mut(), a[..len].as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
-    if FR {
-        ab_flat(hb, w.as_flattened_mut(), al[..len].as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
-    }
-    for (xn, xb) in x.iter().zip(&x_build[lo..lo + len]) {
-        let dd = [xn[0] - xb[0], xn[1] - xb[1], xn[2] - xb[2]];
-        st.disp2 = st.disp2.max(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
-    }
-    st
 }

@@ -5,7 +5,8 @@
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
 //! - `walls`: plate, tube and lid contacts for the particles near them;
-//! - `forces`: the two deterministic parallel passes of a step;
+//! - `forces`: the pair pass of a step (deterministic, parallel) and the shared types;
+//! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
 
@@ -15,6 +16,7 @@ pub mod forces;
 pub mod integrator;
 pub mod neighbors;
 pub mod pair_batch;
+pub mod particle_pass;
 pub mod system;
 pub mod walls;
 

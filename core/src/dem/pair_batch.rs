@@ -172,8 +172,8 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
             b.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
             b.excess[l] = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim * lim;
         }
-        for q in 0..3 {
-            b.f[q][l] = f[q];
+        for (q, fq) in f.into_iter().enumerate() {
+            b.f[q][l] = fq;
         }
     }
 }

@@ -3,7 +3,8 @@
 //! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
 
 use super::contact::V3;
-use super::forces::{accel_pass, pair_pass, update_pass, Acc, Motion, Past, Scratch, Stats};
+use super::forces::{pair_pass, Acc, Past, Scratch, Stats};
+use super::particle_pass::{accel_pass, update_pass, Motion};
 use super::integrator::weights;
 use super::neighbors::{build_list, cell_order, NeighborList};
 use super::walls::WallList;
