@@ -47,25 +47,6 @@ fn angle_of(x: f64, y: f64) -> (f64, f64) {
     }
 }
 
-/// Fluid force on every particle (Cartesian, −V_p∇p + drag) into `force_out`, and the interaction
-/// force per unit volume on the gas, I = −Σ drag / V_cell (cylindrical, cell-centre basis), into
-/// `cell_force_out` (overwritten). `d` is the particle diameter; ε is clamped to [eps_min, 1).
-/// Allocates its work arrays: the step loop keeps an `Exchange` instead.
-#[allow(clippy::too_many_arguments)]
-pub fn particle_gas_forces(
-    grid: &CylGrid,
-    gas: &GasAtCells,
-    mu: f64,
-    eps_min: f64,
-    d: f64,
-    pos: &[[f64; 3]],
-    vel: &[[f64; 3]],
-    force_out: &mut [[f64; 3]],
-    cell_force_out: &mut [[f64; 3]],
-) {
-    Exchange::new(grid, pos.len()).particle_gas_forces(grid, gas, mu, eps_min, d, pos, vel, force_out, cell_force_out);
-}
-
 /// The exchange's work arrays and per-cell basis angles, allocated once per run.
 pub struct Exchange {
     /// (cos θ_c, sin θ_c) of each in-layer cell's centre angle.
@@ -134,7 +115,10 @@ impl Exchange {
         Exchange { cell_basis, cell_of: vec![0; particles], drag: vec![[0.0; 3]; particles], frozen: Vec::new(), cell_drag: Vec::new() }
     }
 
-    /// See the free function `particle_gas_forces`; no allocation.
+    /// Fluid force on every particle (Cartesian, −V_p∇p + drag) into `force_out`, and the
+    /// interaction force per unit volume on the gas, I = −Σ drag / V_cell (cylindrical,
+    /// cell-centre basis), into `cell_force_out` (overwritten). `d` is the particle diameter; ε is
+    /// clamped to [eps_min, 1). No allocation.
     #[allow(clippy::too_many_arguments)]
     pub fn particle_gas_forces(
         &mut self,
@@ -205,7 +189,7 @@ impl Exchange {
     /// The gas side of the exchange for a frozen bed, in O(cells): every particle of a cell is at
     /// rest and sees the same gas state, so its drag differs only by the rotation θ_p − θ_c of the
     /// cell's velocity; summed, I_c = −D(|u_c|)·(C u_r − S u_θ, S u_r + C u_θ, N u_z)/V_cell with
-    /// N, C = Σcos, S = Σsin over the cell's particles. Equal to `particle_gas_forces`' gas side
+    /// N, C = Σcos, S = Σsin over the cell's particles. Equal to `Exchange::particle_gas_forces`' gas side
     /// to round-off; the particles' own forces are not needed (they do not move).
     pub fn frozen_cell_forces(&self, grid: &CylGrid, gas: &GasAtCells, mu: f64, eps_min: f64, d: f64, cell_force_out: &mut [[f64; 3]]) {
         assert_eq!(self.frozen.len(), grid.num_cells(), "freeze() first");
@@ -265,7 +249,7 @@ mod tests {
         let vel = vec![[0.1, 0.0, 0.2], [0.0, 0.0, 0.0], [0.0, -0.3, -0.1]];
         let mut f = vec![[0.0; 3]; 3];
         let mut cf = vec![[0.0; 3]; n];
-        particle_gas_forces(&g, &gas, mu, 0.1, d, &pos, &vel, &mut f, &mut cf);
+        Exchange::new(&g, pos.len()).particle_gas_forces(&g, &gas, mu, 0.1, d, &pos, &vel, &mut f, &mut cf);
         let vp = PI * d * d * d / 6.0;
         for k in 0..3 {
             let w = [-vel[k][0], -vel[k][1], u - vel[k][2]];
@@ -299,7 +283,7 @@ mod tests {
         let vel: Vec<[f64; 3]> = (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
         let (mut f, mut cf) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
         let d = 1.2e-3;
-        particle_gas_forces(&g, &gas, 1.8e-5, 0.1, d, &pos, &vel, &mut f, &mut cf);
+        Exchange::new(&g, pos.len()).particle_gas_forces(&g, &gas, 1.8e-5, 0.1, d, &pos, &vel, &mut f, &mut cf);
         // Σ drag on particles (total force minus −V_p∇p) against −Σ I·V_cell in Cartesian
         let vp = PI * d * d * d / 6.0;
         let mut drag = [0.0; 3];

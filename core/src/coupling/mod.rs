@@ -5,5 +5,5 @@ pub mod exchange;
 pub mod voidage;
 
 pub use drag::{beetstra_f, beta_a, drag_force};
-pub use exchange::{particle_gas_forces, Exchange, GasAtCells};
+pub use exchange::{Exchange, GasAtCells};
 pub use voidage::{build_voidage, voidage_from_solid, VoidageMethod};
