@@ -64,7 +64,10 @@ pub fn run() -> serde_json::Value {
 fn intersect(points: &[(f64, f64)], weight: f64) -> f64 {
     let high: Vec<f64> = points.iter().filter(|p| p.1 >= 0.95 * weight).map(|p| p.1).collect();
     let plateau = if high.is_empty() { weight } else { high.iter().sum::<f64>() / high.len() as f64 };
-    let low: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.1 < 0.85 * plateau).collect();
+    // the fixed-bed branch: below the lowest fluidized speed only (the first stage, still
+    // starting up, can read low too)
+    let u_fluid = points.iter().filter(|p| p.1 >= 0.95 * weight).map(|p| p.0).fold(f64::INFINITY, f64::min);
+    let low: Vec<(f64, f64)> = points.iter().copied().filter(|p| p.0 < u_fluid && p.1 < 0.85 * plateau).collect();
     // Normal equations for ΔP = a U + b U².
     let (mut s11, mut s12, mut s22, mut r1, mut r2) = (0.0, 0.0, 0.0, 0.0, 0.0);
     for &(u, p) in &low {
