@@ -110,7 +110,8 @@ pub fn contact_force<const FRICTION: bool>(
         // Sliding: |F_t| = μ F_n, damping dropped, ξ reset so the spring alone gives F_t.
         let scale = if ft2 > 0.0 { lim / ft2.sqrt() } else { 0.0 };
         ft = [ft[0] * scale, ft[1] * scale, ft[2] * scale];
-        s = [-ft[0] / kt, -ft[1] / kt, -ft[2] / kt];
+        let ikt = -1.0 / kt; // one division for three components (as the batched kernel)
+        s = [ft[0] * ikt, ft[1] * ikt, ft[2] * ikt];
     }
     *shear = s;
     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];

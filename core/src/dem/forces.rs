@@ -8,6 +8,8 @@
 //! This file holds the shared types and pass 1.
 
 use super::pair_batch::{Batch, CAP};
+#[cfg(target_arch = "x86_64")]
+use super::pair_simd::{scan8, LANES};
 use super::contact::{ContactLaw, V3};
 use super::neighbors::NeighborList;
 use super::DemParams;
@@ -70,6 +72,8 @@ pub struct Scratch {
     /// Start of each chunk's buffer in `acc`.
     pub start: Vec<usize>,
     pub acc: Vec<Acc>,
+    /// Row (first particle) of every list entry.
+    pub owner: Vec<u32>,
 }
 
 impl Scratch {
@@ -86,8 +90,19 @@ impl Scratch {
         let mut bounds = Vec::with_capacity(nc);
         let mut start = Vec::with_capacity(nc + 1);
         start.push(0);
+        // Chunk c ends where the work (list entries plus one per particle) reaches (c+1)/nc of
+        // the total, so that the chunks take about the same time.
+        let work = |i: usize| nl.offsets[i] as usize + i;
+        let cut = |c: usize| {
+            let (mut lo, mut hi) = (0, n);
+            while lo < hi {
+                let mid = (lo + hi) / 2;
+                if work(mid) * nc < c * work(n) { lo = mid + 1 } else { hi = mid }
+            }
+            lo
+        };
         for c in 0..nc {
-            let (a, b) = (c * n / nc, (c + 1) * n / nc);
+            let (a, b) = (cut(c), cut(c + 1));
             let mut e = b;
             for i in a..b {
                 for &j in &nl.nbr[nl.offsets[i] as usize..nl.offsets[i + 1] as usize] {
@@ -99,13 +114,15 @@ impl Scratch {
             start.push(start[c] + e - a);
         }
         let len = start[nc];
-        Scratch { bounds, start, acc: vec![[0.0; 6]; len] }
+        let mut owner = Vec::with_capacity(total);
+        for i in 0..n {
+            owner.extend(std::iter::repeat_n(i as u32, (nl.offsets[i + 1] - nl.offsets[i]) as usize));
+        }
+        Scratch { bounds, start, acc: vec![[0.0; 6]; len], owner }
     }
 }
 
-/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers. Pairs whose
-/// gap at the list build exceeds `reach` (twice the largest displacement since, plus a margin)
-/// cannot touch and are skipped: rows are sorted by that gap, so a row stops at the first one.
+/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers.
 pub fn pair_pass<const FR: bool>(
     p: &DemParams,
     x: &[V3],
@@ -113,11 +130,23 @@ pub fn pair_pass<const FR: bool>(
     w: &[V3],
     nl: &mut NeighborList,
     sc: &mut Scratch,
-    reach: f64,
+) -> Stats {
+    pair_pass_with::<FR>(p, x, v, w, nl, sc, true)
+}
+
+/// `pair_pass`, with the vector kernels (when the CPU has them) or the portable code alone.
+pub(crate) fn pair_pass_with<const FR: bool>(
+    p: &DemParams,
+    x: &[V3],
+    v: &[V3],
+    w: &[V3],
+    nl: &mut NeighborList,
+    sc: &mut Scratch,
+    simd: bool,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
-    let gap = &nl.gap;
+    let owner = &sc.owner[..];
     let mut work = Vec::with_capacity(sc.bounds.len());
     let (mut sh_rest, mut to_rest, mut acc_rest) = (&mut nl.shear[..], &mut nl.touch[..], &mut sc.acc[..]);
     for &[a, b, e] in &sc.bounds {
@@ -132,8 +161,8 @@ pub fn pair_pass<const FR: bool>(
     let (law, h) = (&p.pair, p.dt);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
-            let args = ChunkArgs { law, r, h, d2, reach, a, b, offsets, nbr, gap, x, v, w };
-            chunk_pairs_dispatch::<FR>(&args, sh, to, acc)
+            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w };
+            if simd { chunk_pairs_dispatch::<FR>(&args, sh, to, acc) } else { chunk_pairs::<FR, false>(&args, sh, to, acc) }
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }
@@ -144,12 +173,11 @@ struct ChunkArgs<'a> {
     r: f64,
     h: f64,
     d2: f64,
-    reach: f64,
     a: usize,
     b: usize,
     offsets: &'a [u32],
     nbr: &'a [u32],
-    gap: &'a [f32],
+    owner: &'a [u32],
     x: &'a [V3],
     v: &'a [V3],
     w: &'a [V3],
@@ -158,7 +186,10 @@ struct ChunkArgs<'a> {
 fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::arch::is_x86_feature_detected!("avx512f") {
+        if std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("bmi2")
+        {
             // SAFETY: the CPU supports the features the function is compiled for.
             return unsafe { chunk_pairs_avx512::<FR>(c, sh, to, acc) };
         }
@@ -167,79 +198,90 @@ fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [
             return unsafe { chunk_pairs_avx2::<FR>(c, sh, to, acc) };
         }
     }
-    chunk_pairs::<FR>(c, sh, to, acc)
+    chunk_pairs::<FR, false>(c, sh, to, acc)
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
+#[target_feature(enable = "avx512f,avx512vl,bmi2")]
 unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
-    chunk_pairs::<FR>(c, sh, to, acc)
+    chunk_pairs::<FR, true>(c, sh, to, acc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
-    chunk_pairs::<FR>(c, sh, to, acc)
+    chunk_pairs::<FR, false>(c, sh, to, acc)
 }
 
 /// The pair pass over rows a..b: distance checks, touching pairs batched and evaluated, forces
 /// added into `acc` (particles a..).
 #[inline(always)]
-fn chunk_pairs<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
-    let &ChunkArgs { law, r, h, d2, reach, a, b, offsets, nbr, gap, x, v, w } = c;
-    // Compared in f32: rounding `reach` up keeps the test conservative.
-    let reach = {
-        let q = reach as f32;
-        if (q as f64) < reach { f32::from_bits(q.to_bits() + 1) } else { q }
-    };
+fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+    let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
     acc.fill([0.0; 6]);
     let mut st = Stats::ZERO;
-    let base = offsets[a] as usize;
+    let (base, end) = (offsets[a] as usize, offsets[b] as usize);
     let mut batch = Batch::new();
-    // Every entry is written into lane m; only touching ones advance m (no branch).
+    // One flat loop over the chunk's entries (the row of entry k is owner[k]): no row loop,
+    // no data-dependent branch. Every entry is written into lane m; only touching ones
+    // advance m.
     let mut m = 0;
-    for i in a..b {
-        let xi = x[i];
-        let (k0, k1) = (offsets[i] as usize, offsets[i + 1] as usize);
-        for ((k, &j), &g) in (k0..k1).zip(&nbr[k0..k1]).zip(&gap[k0..k1]) {
-            if g > reach {
-                break; // the rest of the row is farther still
-            }
-            let j = j as usize;
-            // SAFETY: `Scratch::plan` checked i < j < x.len() for every listed pair, and the
-            // chunk's `to` covers its rows' entries k0 - base .. k1 - base.
-            let xj = unsafe { *x.get_unchecked(j) };
-            let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-            let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
-            let touching = r2 < d2;
-            if FR {
-                // The history is live only while the pair keeps touching.
-                let t = unsafe { to.get_unchecked_mut(k - base) };
-                batch.was[m] = *t;
-                *t = touching as u8;
-            }
-            batch.set(m, k, i, j, dx, r2);
-            m += touching as usize;
-            if m == CAP {
+    assert!(owner.len() == nbr.len() && end <= nbr.len() && x.len() <= i32::MAX as usize / 3);
+    let mut k = base;
+    #[cfg(target_arch = "x86_64")]
+    if V {
+        while k + LANES <= end {
+            if m > CAP - LANES {
                 batch.m = m;
-                flush::<FR>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+                flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
                 m = 0;
             }
+            // SAFETY: V is set only by the caller compiled for (and checked to have) the
+            // features; bounds as asserted above and in `Scratch::plan`.
+            m = unsafe { scan8::<FR>(k, base, owner, nbr, x, d2, to, &mut batch, m) };
+            k += LANES;
+        }
+        if m == CAP {
+            batch.m = m;
+            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+            m = 0;
+        }
+    }
+    for k in k..end {
+        // SAFETY: k < end ≤ nbr.len() = owner.len() (asserted); `Scratch::plan` checked
+        // i < j < x.len() for every listed pair, and the chunk's `to` covers k - base.
+        let (i, j) = unsafe { (*owner.get_unchecked(k) as usize, *nbr.get_unchecked(k) as usize) };
+        let (xi, xj) = unsafe { (*x.get_unchecked(i), *x.get_unchecked(j)) };
+        let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+        let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
+        let touching = r2 < d2;
+        if FR {
+            // The history is live only while the pair keeps touching.
+            let t = unsafe { to.get_unchecked_mut(k - base) };
+            batch.was[m] = *t;
+            *t = touching as u8;
+        }
+        batch.set(m, k, i, j, dx, r2);
+        m += touching as usize;
+        if m == CAP {
+            batch.m = m;
+            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+            m = 0;
         }
     }
     batch.m = m;
-    flush::<FR>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+    flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
     st
 }
 
 /// Evaluate a batch and add its forces into `acc` (particles a..).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn flush<const FR: bool>(
+fn flush<const FR: bool, const V: bool>(
     batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [V3], base: usize, a: usize,
     acc: &mut [Acc], st: &mut Stats,
 ) {
-    let (ov, ex) = batch.evaluate::<FR>(law, r, h, v, w, sh, base);
+    let (ov, ex) = batch.evaluate::<FR, V>(law, r, h, v, w, sh, base);
     st.overlap = st.overlap.max(ov);
     st.coulomb_excess = st.coulomb_excess.max(ex);
     for l in 0..batch.m {

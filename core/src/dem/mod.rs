@@ -4,6 +4,7 @@
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
+//! - `pair_simd`: AVX-512 scan and gather of the pair pass, eight entries at a time;
 //! - `walls`: plate, tube and lid contacts for the particles near them;
 //! - `forces`: the pair pass of a step (deterministic, parallel) and the shared types;
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
@@ -17,6 +18,7 @@ pub mod integrator;
 pub mod neighbors;
 pub mod pair_batch;
 pub mod particle_pass;
+pub mod pair_simd;
 pub mod system;
 pub mod walls;
 

@@ -19,8 +19,9 @@ pub struct NeighborList {
     pub shear: Vec<[f64; 3]>,
     /// 1 when the pair touched in the last force evaluation (its history is live), else 0.
     pub touch: Vec<u8>,
-    /// Gap |x_j − x_i| − d of each pair at the build; rows are sorted by it, so the pair pass
-    /// can stop a row at the first pair that cannot have closed its gap since the build.
+    /// Gap |x_j − x_i| − d of each pair at the build; rows are sorted by it (nearest first).
+    /// The step does not read it (it scans every entry, branch-free); it stays so that
+    /// checkpoints keep their format.
     pub gap: Vec<f32>,
 }
 

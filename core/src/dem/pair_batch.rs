@@ -8,6 +8,8 @@
 //! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
 use super::contact::{ContactLaw, V3};
+#[cfg(target_arch = "x86_64")]
+use super::pair_simd::{gather8, LANES};
 
 /// Pairs per batch.
 pub const CAP: usize = 64;
@@ -28,9 +30,9 @@ pub struct Batch {
     /// 1 when the pair touched in the previous step (its history is live), else 0.
     pub was: [u8; CAP],
     // Gathered inputs and per-lane diagnostics.
-    vrel: [Lanes; 3],
-    ws: [Lanes; 3],
-    s: [Lanes; 3],
+    pub(super) vrel: [Lanes; 3],
+    pub(super) ws: [Lanes; 3],
+    pub(super) s: [Lanes; 3],
     delta: Lanes,
     excess: Lanes,
     /// Force on i, and n × F_t.
@@ -76,13 +78,29 @@ impl Batch {
     /// with `was` = 0 starts from a zero history). Returns (max overlap, max |F_t|² − (μF_n)²).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub fn evaluate<const FR: bool>(
+    pub fn evaluate<const FR: bool, const V: bool>(
         &mut self, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [V3], base: usize,
     ) -> (f64, f64) {
         let m = self.m.min(CAP);
         let n = v.len();
         assert!(w.len() == n || !FR);
-        for l in 0..m {
+        let mut l0 = 0;
+        #[cfg(target_arch = "x86_64")]
+        if V {
+            assert!(n <= i32::MAX as usize / 3 && shear.len() <= i32::MAX as usize / 3);
+            for l in (0..m).step_by(LANES) {
+                let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
+                for q in l..(l + LANES).min(m) {
+                    let (i, j, k) = (self.i[q] as usize, self.j[q] as usize, self.k[q] as usize);
+                    assert!(i < n && j < n && (!FR || (k >= base && k - base < shear.len())));
+                }
+                // SAFETY: V is set only by the caller compiled for (and checked to have) the
+                // features; l + 8 ≤ CAP (CAP is a multiple of 8); indices checked above.
+                unsafe { gather8::<FR>(self, l, valid, r, v, w, shear, base) };
+            }
+            l0 = m;
+        }
+        for l in l0..m {
             let (i, j) = (self.i[l] as usize, self.j[l] as usize);
             assert!(i < n && j < n);
             // SAFETY: checked just above (one compare for four loads).
@@ -101,21 +119,33 @@ impl Batch {
             }
         }
         lanes::<FR>(self, law, 2.0 * r, h);
-        let mut max_delta: f64 = 0.0;
-        for &d in &self.delta[..m] {
-            max_delta = if d > max_delta { d } else { max_delta };
-        }
+        let max_delta = lane_max(&self.delta[..m], 0.0);
         if !FR {
             return (max_delta, f64::NEG_INFINITY);
         }
-        let mut max_excess = f64::NEG_INFINITY;
+        let max_excess = lane_max(&self.excess[..m], f64::NEG_INFINITY);
         for l in 0..m {
-            let e = self.excess[l];
-            max_excess = if e > max_excess { e } else { max_excess };
             shear[self.k[l] as usize - base] = [self.s[0][l], self.s[1][l], self.s[2][l]];
         }
         (max_delta, max_excess)
     }
+}
+
+/// max(start, values…) with eight independent partial maxima (a vector max, not a serial chain;
+/// max is exact, so the grouping does not change the result).
+#[inline(always)]
+fn lane_max(values: &[f64], start: f64) -> f64 {
+    let mut part = [start; 8];
+    let mut groups = values.chunks_exact(8);
+    for g in &mut groups {
+        for q in 0..8 {
+            part[q] = if g[q] > part[q] { g[q] } else { part[q] };
+        }
+    }
+    for &x in groups.remainder() {
+        part[0] = if x > part[0] { x } else { part[0] };
+    }
+    part.iter().fold(start, |a, &b| if b > a { b } else { a })
 }
 
 impl Default for Box<Batch> {
@@ -159,11 +189,12 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
             // Coulomb: |F_t| = μ F_n, damping dropped, ξ reset to match the spring alone.
             let slide = ft2 > lim * lim;
             let scale = lim / ft2.sqrt();
+            let ikt = -1.0 / kt;
             let mut ft = ft0;
             for q in 0..3 {
                 let scaled = ft0[q] * scale;
                 ft[q] = if slide { scaled } else { ft0[q] };
-                let reset = -ft[q] / kt;
+                let reset = ft[q] * ikt;
                 b.s[q][l] = if slide { reset } else { s[q] };
                 f[q] += ft[q];
             }

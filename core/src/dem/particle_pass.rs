@@ -197,9 +197,14 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al[..len].as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
     }
-    for (xn, xb) in x.iter().zip(&x_build[lo..lo + len]) {
+    // Largest squared displacement since the list build, as eight partial maxima (a vector
+    // max instead of a serial chain; max is exact, so the grouping does not matter).
+    let mut part = [0.0f64; 8];
+    for (l, (xn, xb)) in x.iter().zip(&x_build[lo..lo + len]).enumerate() {
         let dd = [xn[0] - xb[0], xn[1] - xb[1], xn[2] - xb[2]];
-        st.disp2 = st.disp2.max(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
+        let d2 = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+        part[l % 8] = if d2 > part[l % 8] { d2 } else { part[l % 8] };
     }
+    st.disp2 = part.iter().fold(st.disp2, |a, &b| if b > a { b } else { a });
     st
 }

@@ -23,7 +23,7 @@ pub struct DemSystem {
     /// Slot of `past` holding the newer values.
     ring: u8,
     /// Positions at the last neighbour-list build, and the largest displacement from them
-    /// since (over particles and steps).
+    /// since (over particles and steps; a diagnostic, kept in the checkpoint format).
     x_build: Vec<V3>,
     max_disp: f64,
     pub(super) ext: Vec<V3>,
@@ -181,8 +181,7 @@ impl DemSystem {
             self.sc = Scratch::plan(&self.nl, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let reach = self.reach();
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, reach);
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
         let st2 = if self.levels == 0 {
             self.heun::<FR>()
         } else {
@@ -228,8 +227,7 @@ impl DemSystem {
             self.v[i] = step(&v0[i], &d0[i][..3], h);
             self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
-        // The predictor's positions are not covered by `max_disp`: check every listed pair.
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, f64::INFINITY);
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
         accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
         (self.nl.shear, self.nl.touch, self.walls) = (shear1, touch1, walls1);
@@ -253,12 +251,6 @@ impl DemSystem {
         self.ring = newer as u8;
         self.levels = 2;
         Stats { disp2, ..st }
-    }
-
-    /// Pairs with a gap at the list build above this cannot touch now: each partner moved at
-    /// most `max_disp`; the margin (1e-6 of the cutoff) covers the f32 rounding of the gaps.
-    fn reach(&self) -> f64 {
-        2.0 * self.max_disp + 1e-6 * self.p.cutoff
     }
 
     /// Replace the parameters mid-run (bed pouring stiffens the contacts in stages). The state

@@ -1,0 +1,105 @@
+//! AVX-512 kernels of the pair pass, eight lanes at a time, doing the same IEEE operations in the
+//! same order as the scalar code they replace (so the same bits):
+//! - `scan8`: gather both positions of eight list entries, r² < (2R)², and compress the
+//!   touching ones into the next batch lanes (the scalar scan is in `forces`);
+//! - `gather8`: the velocities, spins and live histories of eight batch lanes (the scalar
+//!   gather is in `Batch::evaluate`).
+
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
+use super::contact::V3;
+use super::pair_batch::{Batch, CAP};
+
+/// Lanes this step can add to a batch: a batch with more than `CAP - LANES` filled is flushed
+/// first.
+pub const LANES: usize = 8;
+
+/// Entries k..k+8 (rows `owner`, partners `nbr`, flags `to[k - base..]` when FR) into `batch`
+/// from lane m (≤ CAP − 8); returns the new lane count.
+///
+/// # Safety
+/// The CPU has avx512f, avx512vl and bmi2; k + 8 ≤ owner.len() = nbr.len(); every owner and
+/// partner index < x.len() ≤ i32::MAX / 3; k − base + 8 ≤ to.len() when FR; m ≤ CAP − 8.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,bmi2")]
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn scan8<const FR: bool>(
+    k: usize, base: usize, owner: &[u32], nbr: &[u32], x: &[V3], d2: f64, to: &mut [u8], batch: &mut Batch, m: usize,
+) -> usize {
+    debug_assert!(k + LANES <= owner.len() && k + LANES <= nbr.len() && m <= CAP - LANES);
+    let oi = _mm256_loadu_si256(owner.as_ptr().add(k) as *const __m256i);
+    let oj = _mm256_loadu_si256(nbr.as_ptr().add(k) as *const __m256i);
+    // f64 offsets of x[i][0]: 3 i.
+    let (ti, tj) = (_mm256_add_epi32(_mm256_add_epi32(oi, oi), oi), _mm256_add_epi32(_mm256_add_epi32(oj, oj), oj));
+    let p = x.as_ptr() as *const f64;
+    let mut dx = [_mm512_setzero_pd(); 3];
+    for (a, d) in dx.iter_mut().enumerate() {
+        let xi = _mm512_i32gather_pd::<8>(ti, p.add(a));
+        let xj = _mm512_i32gather_pd::<8>(tj, p.add(a));
+        *d = _mm512_sub_pd(xj, xi);
+    }
+    // r² = (dx₀² + dx₁²) + dx₂², as the scalar scan.
+    let r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx[0], dx[0]), _mm512_mul_pd(dx[1], dx[1])), _mm512_mul_pd(dx[2], dx[2]));
+    let touch: __mmask8 = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(r2, _mm512_set1_pd(d2));
+    const BYTES: u64 = 0x0101_0101_0101_0101;
+    if FR {
+        // Per-entry byte flags: read "touched last step", write "touches now".
+        let t = to.as_mut_ptr().add(k - base) as *mut u64;
+        let was = _pext_u64(t.read_unaligned(), BYTES) as u32;
+        t.write_unaligned(_pdep_u64(touch as u64, BYTES));
+        let kept = _pext_u32(was, touch as u32) as u64;
+        (batch.was.as_mut_ptr().add(m) as *mut u64).write_unaligned(_pdep_u64(kept, BYTES));
+    }
+    // Compressed in registers, stored as whole vectors (lanes past the count are scratch).
+    let kk = _mm256_add_epi32(_mm256_set1_epi32(k as i32), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    _mm256_storeu_si256(batch.k.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, kk));
+    _mm256_storeu_si256(batch.i.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oi));
+    _mm256_storeu_si256(batch.j.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oj));
+    for (a, d) in dx.iter().enumerate() {
+        _mm512_storeu_pd(batch.dx[a].as_mut_ptr().add(m), _mm512_maskz_compress_pd(touch, *d));
+    }
+    _mm512_storeu_pd(batch.r2.as_mut_ptr().add(m), _mm512_maskz_compress_pd(touch, r2));
+    m + touch.count_ones() as usize
+}
+
+/// Lanes l..l+8 of `batch` (those in `valid`): v_i − v_j, R(ω_i + ω_j) and, for lanes whose
+/// history is live, the history `shear[k − base]` (zero otherwise).
+///
+/// # Safety
+/// The CPU has avx512f, avx512vl and bmi2; l + 8 ≤ CAP; for the valid lanes i, j < v.len()
+/// (and w.len() when FR), base ≤ k < base + shear.len(); v.len() ≤ i32::MAX / 3.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,bmi2")]
+#[allow(clippy::too_many_arguments)]
+pub unsafe fn gather8<const FR: bool>(
+    batch: &mut Batch, l: usize, valid: __mmask8, r: f64, v: &[V3], w: &[V3], shear: &[V3], base: usize,
+) {
+    debug_assert!(l + LANES <= CAP);
+    let three = |a: __m256i| _mm256_add_epi32(_mm256_add_epi32(a, a), a);
+    let oi = _mm256_loadu_si256(batch.i.as_ptr().add(l) as *const __m256i);
+    let oj = _mm256_loadu_si256(batch.j.as_ptr().add(l) as *const __m256i);
+    let (ti, tj) = (three(oi), three(oj));
+    let z = _mm512_setzero_pd();
+    let vp = v.as_ptr() as *const f64;
+    for q in 0..3 {
+        let vi = _mm512_mask_i32gather_pd::<8>(z, valid, ti, vp.add(q));
+        let vj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, vp.add(q));
+        _mm512_storeu_pd(batch.vrel[q].as_mut_ptr().add(l), _mm512_sub_pd(vi, vj));
+    }
+    if !FR {
+        return;
+    }
+    let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f64, _mm512_set1_pd(r));
+    let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let tk = three(kk);
+    const BYTES: u64 = 0x0101_0101_0101_0101;
+    let live = valid & _pext_u64((batch.was.as_ptr().add(l) as *const u64).read_unaligned(), BYTES) as __mmask8;
+    for q in 0..3 {
+        let wi = _mm512_mask_i32gather_pd::<8>(z, valid, ti, wp.add(q));
+        let wj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, wp.add(q));
+        _mm512_storeu_pd(batch.ws[q].as_mut_ptr().add(l), _mm512_mul_pd(rr, _mm512_add_pd(wi, wj)));
+        let sq = _mm512_mask_i32gather_pd::<8>(z, live, tk, sp.add(q));
+        _mm512_storeu_pd(batch.s[q].as_mut_ptr().add(l), sq);
+    }
+}
