@@ -41,7 +41,20 @@ pub fn run(small: bool) -> serde_json::Value {
         let prev = &snaps[snaps.len() - 2];
         let (grad_prev, _) = gradient_and_voidage(prev, k1, k2);
         eprintln!("U = {u}: layers {k1}..{k2}, mean ε = {eps:.4}, ΔP/L = {grad:.1} Pa/m (previous {grad_prev:.1}); Beetstra {want:.1} ({:+.2}%), Ergun {erg:.1} ({:+.2}%)", e_b * 100.0, e_e * 100.0);
-        rows.push(json!({"u_m_s": u, "voidage": eps, "dp_dz_pa_m": grad, "beetstra_pa_m": want, "ergun_pa_m": erg, "rel_err": e_b, "ergun_rel_err": e_e}));
+        // The whole bed, plate to top, against its weight: the end layers (the plate's ordered
+        // layer, the partly filled cell at the surface) carry weight with less drag.
+        let weight = bed_weight_per_area(sim.case(), sim.dem().len(), rho);
+        let whole = s.pressure_drop_pa.unwrap_or(f64::NAN) / weight;
+        let fmt = |v: Vec<f64>, k: usize| v.iter().take(k).map(|x| format!("{x:.3}")).collect::<Vec<_>>().join(" ");
+        let nk = ((top / dz).ceil() as usize + 1).min(s.grid.nz);
+        let lp = layers(s, s.pressure_pa.as_ref().unwrap());
+        eprintln!(
+            "  whole bed: ΔP = {:.3} of its weight; layer ε: {}; layer ΔP (Pa): {}",
+            whole,
+            fmt(layers(s, s.voidage.as_ref().unwrap()), nk),
+            fmt(lp.windows(2).map(|w| w[0] - w[1]).collect(), nk)
+        );
+        rows.push(json!({"whole_bed_dp_over_weight": whole, "u_m_s": u, "voidage": eps, "dp_dz_pa_m": grad, "beetstra_pa_m": want, "ergun_pa_m": erg, "rel_err": e_b, "ergun_rel_err": e_e}));
         if e_b.abs() >= worst.0.abs() {
             worst = (e_b, grad, want);
         }

@@ -19,12 +19,12 @@ pub fn pressure_trace(snaps: &[Snapshot], path: &str, _reference: Option<f64>) {
 }
 
 /// ΔP against U from the minimum-fluidization sweep.
-pub fn umf_curve(points: &[(f64, f64)], _weight: f64, _umf: f64, path: &str) {
+pub fn umf_curve(points: &[(f64, f64)], weight: f64, umf: f64, path: &str) {
     let mut p = points.to_vec();
     p.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
     let u: Vec<f64> = p.iter().map(|x| x.0).collect();
     let dp: Vec<f64> = p.iter().map(|x| x.1).collect();
-    save(&plot::trace(&u, &dp), path);
+    save(&plot::trace_marked(&u, &dp, Some(weight), Some(umf)), path);
 }
 
 /// A cell field on the vertical plane through the axis.

@@ -1,21 +1,64 @@
-//! Minimum fluidization by the paper's procedure (section 3.4): U lowered slowly from above U_mf
-//! until the pressure drop starts to fall. U_mf is where the fixed-bed branch (ΔP ∝ U through
-//! the lowest points) meets the fluidized plateau; reference 0.30 m/s (measured, paper).
+//! Minimum fluidization by the paper's procedure (section 3.4): "U was slowly decreased from
+//! above U_mf until the pressure drop across the bed began to decrease". The bed is fluidized at
+//! 0.45 m/s (1.5× the measured U_mf), then U is lowered in steps of 0.025 m/s, each held 0.1 s.
+//! U_mf is where the fixed-bed branch (ΔP = aU + bU² through the points below the plateau)
+//! meets the plateau; reference 0.30 m/s (measured, paper). Default bed: the paper's particles
+//! in a 22-mm column, 20 mm settled (6× cheaper than the paper's 44-mm, 30-mm bed).
+//! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
+//! bed and the sweep (any subset of the keys; also `hold`, seconds per stage).
 
 use crate::common::*;
 use serde_json::json;
 
+/// The sweep and bed, from `FLUIDBED_UMF` over the defaults.
+struct Sweep {
+    column_mm: f64,
+    height_mm: f64,
+    seed: u64,
+    start: f64,
+    step: f64,
+    stages: usize,
+    hold: f64,
+}
+
+impl Sweep {
+    fn from_env() -> Sweep {
+        let mut s = Sweep { column_mm: 22.0, height_mm: 20.0, seed: 2, start: 0.45, step: 0.025, stages: 11, hold: 0.1 };
+        for kv in std::env::var("FLUIDBED_UMF").unwrap_or_default().split(',').filter(|t| !t.is_empty()) {
+            let (k, v) = kv.split_once('=').unwrap_or_else(|| panic!("FLUIDBED_UMF: '{kv}' is not key=value"));
+            let x: f64 = v.parse().unwrap_or_else(|_| panic!("FLUIDBED_UMF: '{v}' is not a number"));
+            match k {
+                "column_mm" => s.column_mm = x,
+                "height_mm" => s.height_mm = x,
+                "seed" => s.seed = x as u64,
+                "start" => s.start = x,
+                "step" => s.step = x,
+                "stages" => s.stages = x as usize,
+                "hold" => s.hold = x,
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold)"),
+            }
+        }
+        s
+    }
+}
+
 pub fn run() -> serde_json::Value {
+    let sw = Sweep::from_env();
     let mut case = load_case("bubbling-44mm.json");
-    // A narrower, shallower bed than the bubbling case (22 mm, 20 mm settled; the paper's
-    // particles and contacts): U_mf is a property of particles and gas, and this is 6× cheaper.
-    case.column.diameter_m = 0.022;
-    case.column.height_m = 0.066;
-    case.grid.dr_m = 0.011 / 3.0;
-    case.voidage = fluidbed_core::case::Voidage::SquareGrid { box_side_m: None, split: fluidbed_core::case::BoxSplit::Cuboid, cube_side_factor: 1.0 };
-    case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed { settled_height_m: Some(0.02), count: None, seed: 2 });
-    let speeds: Vec<f64> = (0..=12).map(|i| 0.45 - 0.025 * i as f64).collect();
-    let (hold, settle) = (0.1, 0.05); // per stage: hold time, of which the first part is discarded
+    if sw.column_mm != 44.0 {
+        // a narrower column: keep three rings per radius
+        case.column.diameter_m = sw.column_mm / 1000.0;
+        case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
+        case.voidage = fluidbed_core::case::Voidage::SquareGrid { box_side_m: None, split: fluidbed_core::case::BoxSplit::Cuboid, cube_side_factor: 1.0 };
+    }
+    if sw.column_mm != 44.0 || sw.height_mm != 30.0 {
+        // a column three bed heights tall (at least 66 mm), a whole number of layers
+        let dz = case.grid.dr_m;
+        case.column.height_m = ((3.0 * sw.height_mm / 1000.0).max(0.066) / dz).round() * dz;
+    }
+    case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed { settled_height_m: Some(sw.height_mm / 1000.0), count: None, seed: sw.seed });
+    let speeds: Vec<f64> = (0..sw.stages).map(|i| sw.start - sw.step * i as f64).collect();
+    let (hold, settle) = (sw.hold, sw.hold / 2.0); // per stage: hold time, of which the first half is discarded
     let g = case.gas.as_mut().unwrap();
     g.superficial_velocity_m_s = speeds[0];
     g.ramp_time_s = 0.05;
@@ -29,6 +72,7 @@ pub fn run() -> serde_json::Value {
     let mut stage = 0usize;
     let mut acc: Vec<f64> = Vec::new();
     let mut points = Vec::new();
+    let mut voidages = Vec::new();
     let first_end = 0.15;
     while !sim.is_finished() {
         let s = match sim.advance(u64::MAX).expect("run") {
@@ -41,8 +85,10 @@ pub fn run() -> serde_json::Value {
         }
         if s.time_s >= stage_end - 1e-9 {
             let dp = acc.iter().sum::<f64>() / acc.len().max(1) as f64;
-            eprintln!("U = {:.3} m/s: ΔP = {dp:.1} Pa ({:.3} of bed weight)", speeds[stage], dp / want_weight);
+            let eps = core_voidage(&sim);
+            eprintln!("U = {:.3} m/s: ΔP = {dp:.1} Pa ({:.3} of bed weight), bed voidage {eps:.3}", speeds[stage], dp / want_weight);
             points.push((speeds[stage], dp));
+            voidages.push(eps);
             acc.clear();
             stage += 1;
             stage_start = stage_end;
@@ -55,7 +101,7 @@ pub fn run() -> serde_json::Value {
     crate::plots::umf_curve(&points, want_weight, umf, "docs/img/umf.png");
     let reference = 0.30;
     eprintln!("{n} particles, bed weight/area {want_weight:.1} Pa: U_mf = {umf:.3} m/s (reference {reference})");
-    json!({"name": "umf", "figure": umf, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight,
+    json!({"name": "umf", "figure": umf, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
            "points": points.iter().map(|(u, p)| json!({"u_m_s": u, "dp_pa": p})).collect::<Vec<_>>()})
 }
 
@@ -85,4 +131,20 @@ fn intersect(points: &[(f64, f64)], weight: f64) -> f64 {
     } else {
         (-a + (a * a + 4.0 * b * plateau).sqrt()) / (2.0 * b)
     }
+}
+
+/// Voidage of the bed's core: particle volume between one diameter above the plate and one
+/// below the bed top, over the column's cross-section (wall zone included).
+fn core_voidage(sim: &fluidbed_core::sim::Simulation) -> f64 {
+    let d = 2.0 * sim.dem().radius();
+    let (lo, hi) = (d, bed_top_m(sim) - d);
+    // a sphere cut by a plane at height h above its centre keeps the cap volume below it
+    let part = |z: f64, cut: f64| -> f64 {
+        let r = d / 2.0;
+        let h = (cut - z).clamp(-r, r); // signed distance of the cut above the centre
+        std::f64::consts::PI * (r + h).powi(2) * (2.0 * r - h) / 3.0 // volume below the cut
+    };
+    let solid: f64 = sim.dem().positions().iter().map(|p| (part(p[2], hi) - part(p[2], lo)).max(0.0)).sum();
+    let area = std::f64::consts::PI * (sim.case().column.diameter_m / 2.0).powi(2);
+    1.0 - solid / (area * (hi - lo))
 }

@@ -8,6 +8,7 @@ use crate::grid::CylGrid;
 const WHITE: [u8; 3] = [255, 255, 255];
 const BLACK: [u8; 3] = [0, 0, 0];
 const BLUE: [u8; 3] = [31, 119, 180];
+const RED: [u8; 3] = [214, 39, 40];
 
 /// Viridis-like colour map, t in [0, 1] (5 stops of matplotlib's viridis, linearly interpolated).
 pub fn colour(t: f64) -> [u8; 3] {
@@ -53,6 +54,12 @@ pub fn axial_slice(grid: &CylGrid, field: &[f64], lo: f64, hi: f64) -> Image {
 
 /// A line plot of y against t with labelled axis ends.
 pub fn trace(t: &[f64], y: &[f64]) -> Image {
+    trace_marked(t, y, None, None)
+}
+
+/// `trace` with a red horizontal line at y = `level` and a red vertical line at t = `at`
+/// (each labelled; the axes widen to hold them).
+pub fn trace_marked(t: &[f64], y: &[f64], level: Option<f64>, at: Option<f64>) -> Image {
     let (w, h, left, bottom, top, right) = (640i64, 400i64, 60i64, 30i64, 15i64, 20i64);
     let mut img = Image::new(w as usize, h as usize, WHITE);
     let (pw, ph) = (w - left - right, h - top - bottom);
@@ -62,11 +69,21 @@ pub fn trace(t: &[f64], y: &[f64]) -> Image {
     if pts.is_empty() {
         return img;
     }
-    let (t0, t1) = span(pts.iter().map(|p| p.0));
-    let (y0, y1) = span(pts.iter().map(|p| p.1));
+    let (t0, t1) = span(pts.iter().map(|p| p.0).chain(at.filter(|a| a.is_finite())));
+    let (y0, y1) = span(pts.iter().map(|p| p.1).chain(level.filter(|l| l.is_finite())));
     let to_px = |(a, b): (f64, f64)| {
         (left + ((a - t0) / (t1 - t0) * pw as f64).round() as i64, top + ph - ((b - y0) / (y1 - y0) * ph as f64).round() as i64)
     };
+    if let Some(l) = level.filter(|l| l.is_finite()) {
+        let (_, yy) = to_px((t0, l));
+        img.line((left, yy), (left + pw, yy), RED);
+        text(&mut img, left + pw - 40, yy - 8, &short(l), RED);
+    }
+    if let Some(a) = at.filter(|a| a.is_finite()) {
+        let (xx, _) = to_px((a, y0));
+        img.line((xx, top), (xx, top + ph), RED);
+        text(&mut img, xx + 3, top + ph - 12, &short(a), RED);
+    }
     for pair in pts.windows(2) {
         img.line(to_px(pair[0]), to_px(pair[1]), BLUE);
     }
@@ -130,5 +147,27 @@ pub fn text(img: &mut Image, x: i64, y: i64, s: &str, c: [u8; 3]) {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn marked_trace_draws_the_level_and_the_mark_where_they_belong() {
+        // y = t over [0, 10]; level 5 and mark 2.5 sit at known fractions of the plot box
+        let t: Vec<f64> = (0..=10).map(|k| k as f64).collect();
+        let img = trace_marked(&t, &t, Some(5.0), Some(2.5));
+        let (left, top, pw, ph) = (60usize, 15usize, 560usize, 355usize);
+        let y_level = top + ph - (0.5 * ph as f64).round() as usize;
+        let x_mark = left + (0.25 * pw as f64).round() as usize;
+        assert_eq!(img.get(left + pw - 60, y_level), RED, "level line");
+        assert_eq!(img.get(x_mark, top + 5), RED, "mark line");
+        assert_ne!(img.get(left + pw - 60, y_level - 20), RED);
+        // without marks the same pixels stay clear
+        let plain = trace(&t, &t);
+        assert_ne!(plain.get(left + pw - 60, y_level), RED);
+        assert_ne!(plain.get(x_mark, top + 5), RED);
     }
 }
