@@ -7,6 +7,7 @@
 //! - `pair_simd`: AVX-512 scan and gather of the pair pass, eight entries at a time;
 //! - `walls`: plate, tube and lid contacts for the particles near them;
 //! - `forces`: the pair pass of a step (deterministic, parallel) and the shared types;
+//! - `work_split`: the pair pass's chunks and their force buffers;
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
@@ -21,6 +22,7 @@ pub mod particle_pass;
 pub mod pair_simd;
 pub mod system;
 pub mod walls;
+pub mod work_split;
 
 #[cfg(test)]
 mod tests;

@@ -1,0 +1,66 @@
+//! The work split of the pair pass (`Scratch`): contiguous particle chunks of about equal work,
+//! each with a private force buffer, planned once per neighbour-list build.
+
+use super::forces::Acc;
+use super::neighbors::NeighborList;
+
+/// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
+/// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
+/// partner index of the chunk. The chunks depend only on the list and the chunk count, and the
+/// buffers are summed in chunk order, so a run is bit-reproducible for a given chunk count.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    /// Per chunk: a, b, e.
+    pub bounds: Vec<[usize; 3]>,
+    /// Start of each chunk's buffer in `acc`.
+    pub start: Vec<usize>,
+    pub acc: Vec<Acc>,
+    /// Row (first particle) of every list entry.
+    pub owner: Vec<u32>,
+}
+
+impl Scratch {
+    /// Plan `chunks` chunks (fewer for small systems) over the list.
+    pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
+        // The pair pass indexes without bounds checks: check the list once here (it may come
+        // from a checkpoint) — rows ascending within 0..n, histories and flags one per entry.
+        let total = nl.nbr.len();
+        assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
+        assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
+        assert!(nl.nbr.iter().all(|&j| (j as usize) < n), "neighbour list index");
+        assert!(nl.shear.len() == total && nl.touch.len() == total && nl.gap.len() == total, "contact history length");
+        let nc = chunks.clamp(1, n.div_ceil(512).max(1));
+        let mut bounds = Vec::with_capacity(nc);
+        let mut start = Vec::with_capacity(nc + 1);
+        start.push(0);
+        // Chunk c ends where the work (list entries plus one per particle) reaches (c+1)/nc of
+        // the total, so that the chunks take about the same time.
+        let work = |i: usize| nl.offsets[i] as usize + i;
+        let cut = |c: usize| {
+            let (mut lo, mut hi) = (0, n);
+            while lo < hi {
+                let mid = (lo + hi) / 2;
+                if work(mid) * nc < c * work(n) { lo = mid + 1 } else { hi = mid }
+            }
+            lo
+        };
+        for c in 0..nc {
+            let (a, b) = (cut(c), cut(c + 1));
+            let mut e = b;
+            for i in a..b {
+                for &j in &nl.nbr[nl.offsets[i] as usize..nl.offsets[i + 1] as usize] {
+                    assert!(j as usize > i, "half list holds j > i only");
+                    e = e.max(j as usize + 1);
+                }
+            }
+            bounds.push([a, b, e]);
+            start.push(start[c] + e - a);
+        }
+        let len = start[nc];
+        let mut owner = Vec::with_capacity(total);
+        for i in 0..n {
+            owner.extend(std::iter::repeat_n(i as u32, (nl.offsets[i + 1] - nl.offsets[i]) as usize));
+        }
+        Scratch { bounds, start, acc: vec![[0.0; 6]; len], owner }
+    }
+}
