@@ -1,7 +1,7 @@
 //! O(N) neighbour search: linked cells give the cell order (particles are re-sorted by cell
 //! at every rebuild for memory locality) and a half Verlet list (each pair once, j > i) in CSR
-//! form, rows sorted by the gap to contact, with the tangential contact history parallel to it. History survives rebuilds
-//! by particle-id pair. Everything here is deterministic and independent of the thread count.
+//! form, each row nearest first (touching pairs lead), with the tangential contact history
+//! parallel to it. History survives rebuilds by particle-id pair. Everything here is deterministic and independent of the thread count.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -19,10 +19,6 @@ pub struct NeighborList {
     pub shear: Vec<[f64; 3]>,
     /// 1 when the pair touched in the last force evaluation (its history is live), else 0.
     pub touch: Vec<u8>,
-    /// Gap |x_j − x_i| − d of each pair at the build; rows are sorted by it (nearest first).
-    /// The step does not read it (it scans every entry, branch-free); it stays so that
-    /// checkpoints keep their format.
-    pub gap: Vec<f32>,
 }
 
 /// Cell order of the particles: the permutation that sorts them by linked cell (stable).
@@ -98,13 +94,12 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
     let c2 = cutoff * cutoff;
     let [nx, ny, nz] = grid.n;
     // Rows built per block in parallel, concatenated in block order.
-    let rows: Vec<(Vec<u32>, Vec<u32>, Vec<f32>)> = (0..x.len().div_ceil(BLOCK))
+    let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(BLOCK))
         .into_par_iter()
         .map(|b| {
             let (a, e) = (b * BLOCK, ((b + 1) * BLOCK).min(x.len()));
             let mut counts = Vec::with_capacity(e - a);
             let mut list = Vec::with_capacity((e - a) * 8);
-            let mut gaps = Vec::with_capacity((e - a) * 8);
             let mut row: Vec<(f32, u32)> = Vec::new();
             for i in a..e {
                 let before = list.len();
@@ -142,27 +137,25 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
                         }
                     }
                 }
+                // nearest first (touching pairs lead; entry order is force summation order)
                 row.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
-                list.extend(row.iter().map(|e| e.1));
-                gaps.extend(row.drain(..).map(|e| e.0));
+                list.extend(row.drain(..).map(|e| e.1));
                 counts.push((list.len() - before) as u32);
             }
-            (counts, list, gaps)
+            (counts, list)
         })
         .collect();
     let mut offsets = Vec::with_capacity(x.len() + 1);
     offsets.push(0u32);
     let total: usize = rows.iter().map(|r| r.1.len()).sum();
     let mut nbr = Vec::with_capacity(total);
-    let mut gap = Vec::with_capacity(total);
-    for (counts, list, gaps) in rows {
+    for (counts, list) in rows {
         for c in counts {
             offsets.push(offsets.last().unwrap() + c);
         }
         nbr.extend_from_slice(&list);
-        gap.extend_from_slice(&gaps);
     }
-    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total], gap }
+    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total] }
 }
 
 impl NeighborList {

@@ -22,10 +22,8 @@ pub struct DemSystem {
     pub(super) past: Past,
     /// Slot of `past` holding the newer values.
     ring: u8,
-    /// Positions at the last neighbour-list build, and the largest displacement from them
-    /// since (over particles and steps; a diagnostic, kept in the checkpoint format).
+    /// Positions at the last neighbour-list build.
     x_build: Vec<V3>,
-    max_disp: f64,
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
     pub(super) nl: NeighborList,
@@ -61,7 +59,6 @@ impl DemSystem {
             past: Past::zeros(n),
             ring: 0,
             x_build: Vec::new(),
-            max_disp: 0.0,
             ext: vec![[0.0; 3]; n],
             ids: (0..n as u32).collect(),
             nl: NeighborList::default(),
@@ -202,7 +199,6 @@ impl DemSystem {
             st
         };
         let st = st1.max(st2);
-        self.max_disp = self.max_disp.max(st.disp2.sqrt());
         self.last = (st.overlap, st.coulomb_excess);
         if st.disp2 > 0.25 * self.p.skin * self.p.skin {
             self.rebuild_due = true;
@@ -281,7 +277,6 @@ impl DemSystem {
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc = Scratch::default();
         self.x_build = self.x.clone();
-        self.max_disp = 0.0;
         self.rebuild_due = false;
     }
 }

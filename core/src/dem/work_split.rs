@@ -28,7 +28,7 @@ impl Scratch {
         assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
         assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
         assert!(nl.nbr.iter().all(|&j| (j as usize) < n), "neighbour list index");
-        assert!(nl.shear.len() == total && nl.touch.len() == total && nl.gap.len() == total, "contact history length");
+        assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
         let mut bounds = Vec::with_capacity(nc);
         let mut start = Vec::with_capacity(nc + 1);
