@@ -62,6 +62,15 @@ impl Stats {
     }
 }
 
+/// Which code the pair pass runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernels {
+    /// The vector kernels the CPU has (AVX-512, AVX2), picked at run time.
+    Best,
+    /// The portable code alone (tests compare the two).
+    Portable,
+}
+
 /// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers.
 pub fn pair_pass<const FR: bool>(
     p: &DemParams,
@@ -70,19 +79,7 @@ pub fn pair_pass<const FR: bool>(
     w: &[V3],
     nl: &mut NeighborList,
     sc: &mut Scratch,
-) -> Stats {
-    pair_pass_with::<FR>(p, x, v, w, nl, sc, true)
-}
-
-/// `pair_pass`, with the vector kernels (when the CPU has them) or the portable code alone.
-pub(crate) fn pair_pass_with<const FR: bool>(
-    p: &DemParams,
-    x: &[V3],
-    v: &[V3],
-    w: &[V3],
-    nl: &mut NeighborList,
-    sc: &mut Scratch,
-    simd: bool,
+    kernels: Kernels,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
@@ -102,7 +99,10 @@ pub(crate) fn pair_pass_with<const FR: bool>(
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
             let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w };
-            if simd { chunk_pairs_dispatch::<FR>(&args, sh, to, acc) } else { chunk_pairs::<FR, false>(&args, sh, to, acc) }
+            match kernels {
+                Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
+                Kernels::Portable => chunk_pairs::<FR, false>(&args, sh, to, acc),
+            }
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }

@@ -3,7 +3,7 @@
 //! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
 
 use super::contact::V3;
-use super::forces::{pair_pass, Acc, Past, Scratch, Stats};
+use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
 use super::particle_pass::{accel_pass, update_pass, Motion};
 use super::integrator::weights;
 use super::neighbors::{build_list, cell_order, NeighborList};
@@ -178,7 +178,7 @@ impl DemSystem {
             self.sc = Scratch::plan(&self.nl, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, Kernels::Best);
         let st2 = if self.levels == 0 {
             self.heun::<FR>()
         } else {
@@ -223,7 +223,7 @@ impl DemSystem {
             self.v[i] = step(&v0[i], &d0[i][..3], h);
             self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc);
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, Kernels::Best);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
         accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
         (self.nl.shear, self.nl.touch, self.walls) = (shear1, touch1, walls1);

@@ -27,23 +27,22 @@ fn batched_pair_kernel_equals_the_scalar_contact_law() {
     let v: Vec<[f64; 3]> = (0..2 * n).map(|_| [u(1.0), u(1.0), u(1.0)]).collect();
     let w: Vec<[f64; 3]> = (0..2 * n).map(|_| [u(500.0), u(500.0), u(500.0)]).collect();
     let shear0: Vec<[f64; 3]> = (0..n).map(|_| [u(1e-6), u(1e-6), u(1e-6)]).collect();
-    let mut batch = Batch::new();
-    for l in 0..n {
-        let (i, j) = (2 * l, 2 * l + 1);
-        let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-        batch.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
-    }
-    batch.m = n;
-    let mut vector = None;
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("bmi2") {
-        let mut b2 = Batch::new();
+    // Lane l holds the pair (2l, 2l + 1).
+    let filled = || {
+        let mut b = Batch::new();
         for l in 0..n {
             let (i, j) = (2 * l, 2 * l + 1);
             let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-            b2.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+            b.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
         }
-        b2.m = n;
+        b.m = n;
+        b
+    };
+    let mut batch = filled();
+    let mut vector = None;
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("bmi2") {
+        let mut b2 = filled();
         let mut shear = shear0.clone();
         b2.evaluate::<true, true>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
         vector = Some((b2, shear));
@@ -85,7 +84,7 @@ fn rng_frac(l: usize) -> f64 {
 /// dispatch takes the portable code and the comparison is trivially equal.
 #[test]
 fn vector_pair_pass_equals_the_portable_one() {
-    use crate::dem::forces::{pair_pass_with, Scratch};
+    use crate::dem::forces::{pair_pass, Kernels, Scratch};
     let case = with_damping(test_case(0.02, 0.03, false, 9.81, 1e-6), 0.1, 0.05, 0.3);
     let d = case.particles.diameter_m;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
@@ -116,13 +115,13 @@ fn vector_pair_pass_equals_the_portable_one() {
         *t = rng.gen::<bool>() as u8;
     }
     let p = sys.p.clone();
-    let run = |simd: bool| {
+    let run = |kernels: Kernels| {
         let mut nl = sys.nl.clone();
         let mut sc = Scratch::plan(&nl, sys.x.len(), 3);
-        let st = pair_pass_with::<true>(&p, &sys.x, &sys.v, &sys.w, &mut nl, &mut sc, simd);
+        let st = pair_pass::<true>(&p, &sys.x, &sys.v, &sys.w, &mut nl, &mut sc, kernels);
         (st.overlap, st.coulomb_excess, sc.acc, nl.touch, nl.shear)
     };
-    let (portable, vector) = (run(false), run(true));
+    let (portable, vector) = (run(Kernels::Portable), run(Kernels::Best));
     let touching = portable.3.iter().filter(|&&t| t == 1).count();
     assert!(touching > 1000 && touching < portable.3.len(), "{touching} of {} entries touch", portable.3.len());
     assert!(portable.1 > -1e-30, "some contacts slide (Coulomb excess {})", portable.1);
