@@ -16,31 +16,39 @@ pub struct RunSummary {
     /// Largest share of nearly empty cells (ε > 0.8) below 30 mm after t = 0.4 s.
     pub bubble_fraction_max: f64,
     pub wall_s: f64,
+    /// Momentum budget of the particles per snapshot: (time, plate, tube, gas force, momentum),
+    /// vertical components in N and kg m/s (empty in runs kept by earlier builds).
+    #[serde(default)]
+    pub budget: Vec<[f64; 5]>,
 }
 
-const CACHE: &str = "target/validate-cache/bubbling-44mm-1s.json";
-
-/// The one-second run of cases/bubbling-44mm.json, from the cache or run now.
-pub fn one_second_run() -> RunSummary {
-    if let Some(r) = std::fs::read_to_string(CACHE).ok().and_then(|t| serde_json::from_str(&t).ok()) {
-        eprintln!("using the run kept in {CACHE} (delete it to run again)");
+/// The run of cases/bubbling-44mm.json to `end_s`, from the cache or run now.
+pub fn run_to(end_s: f64) -> RunSummary {
+    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s.json");
+    let cache = cache.as_str();
+    if let Some(r) = std::fs::read_to_string(cache).ok().and_then(|t| serde_json::from_str(&t).ok()) {
+        eprintln!("using the run kept in {cache} (delete it to run again)");
         return r;
     }
     let mut case = load_case("bubbling-44mm.json");
-    case.end_time_s = 1.0;
+    case.end_time_s = end_s;
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
     let t0 = std::time::Instant::now();
     let mut sim = fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build");
     let mut snaps = Vec::new();
+    let mut budget = Vec::new();
     while !sim.is_finished() {
         if let Some(s) = sim.advance(u64::MAX).unwrap_or_else(|e| panic!("bubbling: {e}")) {
+            let dem = sim.dem();
+            let [plate, tube, _] = dem.wall_loads();
+            budget.push([s.time_s, plate, tube, dem.external_force_total()[2], dem.momentum()[2]]);
             if s.index % 10 == 0 {
                 eprintln!("[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s", s.time_s, s.pressure_drop_pa.unwrap_or(0.0), t0.elapsed().as_secs_f64());
                 // the ΔP series so far, in case the run is stopped early
                 let dp: Vec<(f64, f64)> = snaps.iter().chain(std::iter::once(&s)).filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p))).collect();
                 std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-                std::fs::write(format!("{CACHE}.partial"), serde_json::to_string(&dp).unwrap()).expect("write partial");
+                std::fs::write(format!("{cache}.partial"), serde_json::to_string(&dp).unwrap()).expect("write partial");
             }
             snaps.push(s);
         }
@@ -53,25 +61,27 @@ pub fn one_second_run() -> RunSummary {
         let f = bed.iter().filter(|&&e| e > 0.8).count() as f64 / bed.len() as f64;
         bubble_fraction_max = bubble_fraction_max.max(f);
         let ms = (s.time_s * 1000.0).round() as i64;
-        if ms >= 700 && ms % 50 == 0 {
+        if (700..=1000).contains(&ms) && ms % 50 == 0 {
             crate::plots::slice(s, eps, 0.35, 1.0, &format!("docs/img/bubbling_voidage_{ms:04}ms.png"));
         }
     }
-    crate::plots::pressure_trace(&snaps, "docs/img/bubbling_dp.png", None);
+    let trace = if end_s == 1.0 { "docs/img/bubbling_dp.png".to_string() } else { format!("docs/img/bubbling_dp_{end_s}s.png") };
+    crate::plots::pressure_trace(&snaps, &trace, None);
     let r = RunSummary {
         particles: sim.dem().len(),
         end_s: sim.time(),
         dp: snaps.iter().filter_map(|s| s.pressure_drop_pa.map(|p| (s.time_s, p))).collect(),
         bubble_fraction_max,
         wall_s: t0.elapsed().as_secs_f64(),
+        budget,
     };
     std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-    std::fs::write(CACHE, serde_json::to_string(&r).unwrap()).expect("write cache");
+    std::fs::write(cache, serde_json::to_string(&r).unwrap()).expect("write cache");
     r
 }
 
 pub fn run() -> serde_json::Value {
-    let r = one_second_run();
+    let r = run_to(1.0);
     let case = load_case("bubbling-44mm.json");
     let want = bed_weight_per_area(&case, r.particles, case.gas.as_ref().unwrap().outlet_density_kg_m3());
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= 0.4).map(|x| x.1).collect();

@@ -1,13 +1,16 @@
 //! Fluidized bed (issue: coupling): the 44-mm bed of 30 mm settled height at U = 0.6 m/s. The
 //! time-mean pressure drop across the bed must be within 2% of the bed weight per area less
-//! buoyancy (PHYSICS.md 10). It reads the same one-second run as `bubbling` (run once, kept in
-//! target/validate-cache), averaging from t = 0.4 s (after the 240-ms ramp and first bubbles).
+//! buoyancy (PHYSICS.md 10). It reads the same run as `bubbling` (run once, kept in
+//! target/validate-cache), averaging from t = 0.4 s (after the 240-ms ramp and first bubbles);
+//! `FLUIDBED_FLUIDIZED_END_S` sets a longer run. It also prints the particles' momentum budget
+//! over the same window: weight = gas force + plate + tube − d(momentum)/dt.
 
 use crate::common::*;
 use serde_json::json;
 
 pub fn run() -> serde_json::Value {
-    let r = crate::bubbling::one_second_run();
+    let end_s: f64 = std::env::var("FLUIDBED_FLUIDIZED_END_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1.0);
+    let r = crate::bubbling::run_to(end_s);
     let t_avg = 0.4;
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= t_avg).map(|x| x.1).collect();
     let mean = tail.iter().sum::<f64>() / tail.len() as f64;
@@ -17,5 +20,17 @@ pub fn run() -> serde_json::Value {
     let want = bed_weight_per_area(&case, r.particles, rho_g);
     let rel = mean / want - 1.0;
     eprintln!("{} particles; mean ΔP over {t_avg} ≤ t ≤ {} s = {mean:.1} Pa (σ = {sd:.1} Pa, {} snapshots); bed weight / area = {want:.1} Pa; {:+.2}%", r.particles, r.end_s, tail.len(), rel * 100.0);
-    json!({"name": "fluidized", "figure": mean, "reference": want, "rel_err": rel, "std_pa": sd, "particles": r.particles, "t_avg_from_s": t_avg, "end_s": r.end_s})
+    let mut out = json!({"name": "fluidized", "figure": mean, "reference": want, "rel_err": rel, "std_pa": sd, "particles": r.particles, "t_avg_from_s": t_avg, "end_s": r.end_s});
+    let b: Vec<&[f64; 5]> = r.budget.iter().filter(|x| x[0] >= t_avg).collect();
+    if b.len() > 1 {
+        // shares of the weight N m g, time means over the window
+        let weight = r.particles as f64 * case.particle_mass_kg() * case.gravity_m_s2;
+        let share = |k: usize| b.iter().map(|x| x[k]).sum::<f64>() / b.len() as f64 / weight;
+        let (first, last) = (b[0], b[b.len() - 1]);
+        let inertia = (last[4] - first[4]) / (last[0] - first[0]) / weight;
+        let (gas, plate, tube) = (share(3), share(1), share(2));
+        eprintln!("share of the particles' weight carried, mean over the window: gas {gas:.4}, plate {plate:.4}, tube {tube:.4}; momentum change {inertia:+.4}; unbalanced {:+.4}", gas + plate + tube - inertia - 1.0);
+        out["weight_share"] = json!({"gas": gas, "plate": plate, "tube": tube, "momentum_change": inertia});
+    }
+    out
 }

@@ -148,6 +148,22 @@ impl DemSystem {
         e
     }
 
+    /// Vertical force of the plate, the tube and the lid on the particles now (`walls::wall_loads`).
+    pub fn wall_loads(&self) -> [f64; 3] {
+        super::walls::wall_loads(&self.p, &self.x, &self.v, &self.w, &self.walls)
+    }
+
+    /// External (gas) force summed over the particles.
+    pub fn external_force_total(&self) -> V3 {
+        self.ext.iter().fold([0.0; 3], |a, f| [a[0] + f[0], a[1] + f[1], a[2] + f[2]])
+    }
+
+    /// Total linear momentum of the particles.
+    pub fn momentum(&self) -> V3 {
+        let m = self.p.mass;
+        self.v.iter().fold([0.0; 3], |a, u| [a[0] + m * u[0], a[1] + m * u[1], a[2] + m * u[2]])
+    }
+
     /// Largest overlap over the diameter in the last step (pairs and walls).
     pub fn max_overlap_fraction(&self) -> f64 {
         self.last.0 / (2.0 * self.p.radius)

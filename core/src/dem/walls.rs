@@ -95,3 +95,27 @@ pub fn wall_forces<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: 
     }
     (ov, ex)
 }
+
+/// Vertical force of each wall (plate, tube, lid) on the particles at the current state, from
+/// the contact law with copies of the stored histories (nothing changes). For momentum budgets:
+/// the part of the bed's weight the walls carry.
+pub fn wall_loads(p: &DemParams, x: &[V3], v: &[V3], w: &[V3], list: &WallList) -> [f64; 3] {
+    let (law, r, h) = (&p.wall, p.radius, p.dt);
+    let reach = p.tube_radius - r;
+    let mut load = [0.0; 3];
+    for (&i, hist) in list.idx.iter().zip(&list.hist) {
+        let (xi, vi, wi) = (x[i as usize], v[i as usize], w[i as usize]);
+        let rho = (xi[0] * xi[0] + xi[1] * xi[1]).sqrt().max(f64::MIN_POSITIVE);
+        let walls = [
+            (r - xi[2], [0.0, 0.0, -1.0]),
+            (rho - reach, [xi[0] / rho, xi[1] / rho, 0.0]),
+            (if p.lid { xi[2] + r - p.height } else { -1.0 }, [0.0, 0.0, 1.0]),
+        ];
+        for (k, (delta, nrm)) in walls.into_iter().enumerate() {
+            let (mut hk, mut acc) = (hist[k], [0.0; 6]);
+            wall_contact::<true>(law, r, h, delta, nrm, vi, wi, &mut hk, &mut acc);
+            load[k] += acc[2];
+        }
+    }
+    load
+}

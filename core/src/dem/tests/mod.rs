@@ -8,6 +8,7 @@ mod integrator_order;
 mod poured_bed;
 mod restitution;
 mod sliding;
+mod wall_loads;
 
 use crate::case::{Bed, Case, Column, Damping, ExplicitBed, Particles};
 
