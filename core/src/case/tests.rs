@@ -106,3 +106,21 @@ fn published_schema_is_current() {
     let have = std::fs::read_to_string(path).unwrap_or_default();
     assert!(have == want, "docs/case.schema.json is stale: regenerate it (see this test's comment)");
 }
+
+#[test]
+fn every_shipped_case_parses_without_errors() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../cases");
+    let mut seen = 0;
+    for entry in std::fs::read_dir(dir).expect("cases/") {
+        let path = entry.unwrap().path();
+        if path.extension().is_some_and(|e| e == "json") {
+            let text = std::fs::read_to_string(&path).unwrap();
+            match Case::parse_str(&text) {
+                Ok((_, rep)) => assert!(rep.errors.is_empty(), "{}: {:?}", path.display(), rep.errors),
+                Err(rep) => panic!("{}: {:?}", path.display(), rep.errors),
+            }
+            seen += 1;
+        }
+    }
+    assert!(seen >= 9, "found {seen} cases");
+}
