@@ -108,10 +108,12 @@ pub fn contact_force<const FRICTION: bool>(
     let lim = law.mu * fnorm.abs();
     if ft2 > lim * lim {
         // Sliding: |F_t| = μ F_n, damping dropped, ξ reset so the spring alone gives F_t.
-        let scale = if ft2 > 0.0 { lim / ft2.sqrt() } else { 0.0 };
+        // One division for both: q = μF_n / (|F_t| K_t δ^{1/2}); F_t scales by q K_t and the
+        // reset history is −F_t,trial q (as the batched kernel).
+        let q = lim / (ft2.sqrt() * kt);
+        let scale = q * kt;
+        s = [-ft[0] * q, -ft[1] * q, -ft[2] * q];
         ft = [ft[0] * scale, ft[1] * scale, ft[2] * scale];
-        let ikt = -1.0 / kt; // one division for three components (as the batched kernel)
-        s = [ft[0] * ikt, ft[1] * ikt, ft[2] * ikt];
     }
     *shear = s;
     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];

@@ -188,13 +188,13 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
             let lim = mu * fnorm.abs();
             // Coulomb: |F_t| = μ F_n, damping dropped, ξ reset to match the spring alone.
             let slide = ft2 > lim * lim;
-            let scale = lim / ft2.sqrt();
-            let ikt = -1.0 / kt;
+            let qs = lim / (ft2.sqrt() * kt); // one division, as `contact_force`
+            let scale = qs * kt;
             let mut ft = ft0;
             for q in 0..3 {
                 let scaled = ft0[q] * scale;
                 ft[q] = if slide { scaled } else { ft0[q] };
-                let reset = ft[q] * ikt;
+                let reset = -ft0[q] * qs;
                 b.s[q][l] = if slide { reset } else { s[q] };
                 f[q] += ft[q];
             }
