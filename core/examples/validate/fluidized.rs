@@ -1,16 +1,15 @@
 //! Fluidized bed (issue: coupling): the 44-mm bed of 30 mm settled height at U = 0.6 m/s. The
 //! time-mean pressure drop across the bed must be within 2% of the bed weight per area less
-//! buoyancy (PHYSICS.md 10), plus the gas's own head between the two pressure points. It reads the same run as `bubbling` (run once, kept in
-//! target/validate-cache), averaging from t = 0.4 s (after the 240-ms ramp and first bubbles);
-//! `FLUIDBED_FLUIDIZED_END_S` sets a longer run. It also prints the particles' momentum budget
-//! over the same window: weight = gas force + plate + tube − d(momentum)/dt.
+//! buoyancy (PHYSICS.md 10), plus the gas's own head between the two pressure points. It reads
+//! the run of `bubbling` (2 simulated seconds, kept in target/validate-cache), averaging from
+//! t = 0.4 s (after the 240-ms ramp and the first bubbles). It also prints the particles' momentum
+//! budget over the same window: weight = gas force + plate + tube − d(momentum)/dt.
 
 use crate::common::*;
 use serde_json::json;
 
 pub fn run() -> serde_json::Value {
-    let end_s: f64 = std::env::var("FLUIDBED_FLUIDIZED_END_S").ok().and_then(|s| s.parse().ok()).unwrap_or(1.0);
-    let r = crate::bubbling::run_to(end_s);
+    let r = crate::bubbling::run_to(crate::bubbling::end_s());
     let t_avg = 0.4;
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= t_avg).map(|x| x.1).collect();
     let mean = tail.iter().sum::<f64>() / tail.len() as f64;
