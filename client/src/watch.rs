@@ -146,7 +146,17 @@ impl Bar {
                 );
                 let _ = std::io::stderr().flush();
             }
-            "status" if !self.tty => eprintln!("status: {}", d["status"].as_str().unwrap_or("?")),
+            "status" => {
+                let m = d["message"].as_str().map(|m| format!(" — {m}")).unwrap_or_default();
+                if self.tty {
+                    if !m.is_empty() {
+                        eprint!("\rstatus: {}{m}   ", d["status"].as_str().unwrap_or("?"));
+                        let _ = std::io::stderr().flush();
+                    }
+                } else {
+                    eprintln!("status: {}{m}", d["status"].as_str().unwrap_or("?"));
+                }
+            }
             _ => {}
         }
     }

@@ -151,6 +151,12 @@ impl Store {
         Ok(())
     }
 
+    /// What a running job is doing when that is not stepping (e.g. preparing its bed); None clears it.
+    pub fn set_message(&self, id: &str, message: Option<&str>) -> Result<()> {
+        self.db().execute("UPDATE jobs SET message = ?2 WHERE id = ?1 AND status = 'running'", params![id, message])?;
+        Ok(())
+    }
+
     pub fn set_plan(&self, id: &str, plan: &serde_json::Value) -> Result<()> {
         self.db().execute("UPDATE jobs SET plan = ?2 WHERE id = ?1", params![id, plan.to_string()])?;
         Ok(())

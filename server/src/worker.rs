@@ -127,10 +127,20 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
         None => {
             let case_json = app.store.case_json(id)?.unwrap_or_default();
             let case: Case = serde_json::from_str(&case_json)?;
-            match Simulation::new(case, Some(&app.store.cache_dir())) {
+            // A generated bed is poured and settled first (minutes for a large bed, then
+            // cached): say so, since the run's progress stays at 0 meanwhile.
+            let preparing = matches!(case.bed, fluidbed_core::case::Bed::Generated(_));
+            if preparing {
+                say(app, id, Some("preparing the bed: pouring and settling the particles (reused from the cache if this bed was made before)"))?;
+            }
+            let sim = match Simulation::new(case, Some(&app.store.cache_dir())) {
                 Ok(s) => s,
                 Err(e) => return fail(app, id, &e.to_string()),
+            };
+            if preparing {
+                say(app, id, None)?;
             }
+            sim
         }
     };
     if app.stopping() {
@@ -193,6 +203,15 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
         }
     }
     finish(app, id, Status::Succeeded, None);
+    Ok(())
+}
+
+/// Set (or clear) a running job's message and tell the listeners with a `status` event.
+fn say(app: &Arc<App>, id: &str, message: Option<&str>) -> Result<()> {
+    app.store.set_message(id, message)?;
+    if let Some(job) = app.store.get(id)? {
+        app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+    }
     Ok(())
 }
 
