@@ -27,6 +27,13 @@ pub fn umf_curve(points: &[(f64, f64)], weight: f64, umf: f64, path: &str) {
     save(&plot::trace_marked(&u, &dp, Some(weight), Some(umf)), path);
 }
 
+/// A time series (t, y) with a red horizontal line at `level` (e.g. its expected or mean value).
+pub fn series_with_level(points: &[(f64, f64)], level: f64, path: &str) {
+    let t: Vec<f64> = points.iter().map(|x| x.0).collect();
+    let y: Vec<f64> = points.iter().map(|x| x.1).collect();
+    save(&plot::trace_marked(&t, &y, Some(level), None), path);
+}
+
 /// A cell field on the vertical plane through the axis.
 pub fn slice(s: &Snapshot, field: &[f64], lo: f64, hi: f64, path: &str) {
     save(&plot::axial_slice(&s.grid.grid(), field, lo, hi), path);
