@@ -50,12 +50,12 @@ impl WallList {
     }
 }
 
-/// One wall contact: overlap `delta` along the outward normal `nrm`; adds force and n × F_t.
-/// Returns (overlap, Coulomb excess) for the diagnostics.
+/// One wall contact: overlap `delta` along the outward normal `nrm`; hands wall `k`'s force and
+/// n × F_t to `on`. Returns (overlap, Coulomb excess) for the diagnostics.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn wall_contact<const FR: bool>(
-    law: &ContactLaw, r: f64, h: f64, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3, acc: &mut [f64; 6],
+    law: &ContactLaw, r: f64, h: f64, k: usize, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3, on: &mut impl FnMut(usize, &[f64; 6]),
 ) -> (f64, f64) {
     if delta <= 0.0 {
         *hist = [0.0; 3];
@@ -63,59 +63,55 @@ fn wall_contact<const FR: bool>(
     }
     let ws = [r * wi[0], r * wi[1], r * wi[2]];
     let cf = contact_force::<FR>(law, delta, nrm, vi, ws, hist, h);
-    for k in 0..3 {
-        acc[k] += cf.f[k];
-        acc[3 + k] += cf.c[k];
-    }
+    on(k, &[cf.f[0], cf.f[1], cf.f[2], cf.c[0], cf.c[1], cf.c[2]]);
     (delta, if FR { cf.excess } else { f64::NEG_INFINITY })
 }
 
-/// All wall forces on a particle at `xi` (force and n × F_t summed into `acc`); returns the
-/// largest overlap and Coulomb excess.
-#[inline]
-pub fn wall_forces<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], acc: &mut [f64; 6]) -> (f64, f64) {
+/// Every wall contact of a particle at `xi`: wall k (0 plate, 1 tube, 2 lid) hands its force
+/// and n × F_t to `on`; returns the largest overlap and Coulomb excess.
+#[inline(always)]
+fn each_wall<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], mut on: impl FnMut(usize, &[f64; 6])) -> (f64, f64) {
     let (law, r, h) = (&p.wall, p.radius, p.dt);
     let [h0, h1, h2] = hist;
     // Distributor plate z = 0: normal (0,0,−1).
-    let (mut ov, mut ex) = wall_contact::<FR>(law, r, h, r - xi[2], [0.0, 0.0, -1.0], vi, wi, h0, acc);
+    let (mut ov, mut ex) = wall_contact::<FR>(law, r, h, 0, r - xi[2], [0.0, 0.0, -1.0], vi, wi, h0, &mut on);
     // Tube of radius R_t: outward radial normal.
     let rho2 = xi[0] * xi[0] + xi[1] * xi[1];
     let reach = p.tube_radius - r;
     if rho2 > reach * reach {
         let rho = rho2.sqrt();
         let nrm = [xi[0] / rho, xi[1] / rho, 0.0];
-        let (o, e) = wall_contact::<FR>(law, r, h, rho - reach, nrm, vi, wi, h1, acc);
+        let (o, e) = wall_contact::<FR>(law, r, h, 1, rho - reach, nrm, vi, wi, h1, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     } else {
         *h1 = [0.0; 3];
     }
     if p.lid {
-        let (o, e) = wall_contact::<FR>(law, r, h, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, acc);
+        let (o, e) = wall_contact::<FR>(law, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     }
     (ov, ex)
+}
+
+/// All wall forces on a particle at `xi` (force and n × F_t summed into `acc`); returns the
+/// largest overlap and Coulomb excess.
+#[inline]
+pub fn wall_forces<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], acc: &mut [f64; 6]) -> (f64, f64) {
+    each_wall::<FR>(p, xi, vi, wi, hist, |_, fc| {
+        for (a, f) in acc.iter_mut().zip(fc) {
+            *a += f;
+        }
+    })
 }
 
 /// Vertical force of each wall (plate, tube, lid) on the particles at the current state, from
 /// the contact law with copies of the stored histories (nothing changes). For momentum budgets:
 /// the part of the bed's weight the walls carry.
 pub fn wall_loads(p: &DemParams, x: &[V3], v: &[V3], w: &[V3], list: &WallList) -> [f64; 3] {
-    let (law, r, h) = (&p.wall, p.radius, p.dt);
-    let reach = p.tube_radius - r;
     let mut load = [0.0; 3];
     for (&i, hist) in list.idx.iter().zip(&list.hist) {
-        let (xi, vi, wi) = (x[i as usize], v[i as usize], w[i as usize]);
-        let rho = (xi[0] * xi[0] + xi[1] * xi[1]).sqrt().max(f64::MIN_POSITIVE);
-        let walls = [
-            (r - xi[2], [0.0, 0.0, -1.0]),
-            (rho - reach, [xi[0] / rho, xi[1] / rho, 0.0]),
-            (if p.lid { xi[2] + r - p.height } else { -1.0 }, [0.0, 0.0, 1.0]),
-        ];
-        for (k, (delta, nrm)) in walls.into_iter().enumerate() {
-            let (mut hk, mut acc) = (hist[k], [0.0; 6]);
-            wall_contact::<true>(law, r, h, delta, nrm, vi, wi, &mut hk, &mut acc);
-            load[k] += acc[2];
-        }
+        let i = i as usize;
+        each_wall::<true>(p, x[i], v[i], w[i], &mut hist.clone(), |k, fc| load[k] += fc[2]);
     }
     load
 }
