@@ -18,20 +18,22 @@ pub fn pressure_trace(snaps: &[Snapshot], path: &str, _reference: Option<f64>) {
     save(&plot::trace(&t, &y), path);
 }
 
-/// ΔP against U from the minimum-fluidization sweep.
+/// ΔP against U from the minimum-fluidization sweep, with the weight and U_mf marked.
 pub fn umf_curve(points: &[(f64, f64)], weight: f64, umf: f64, path: &str) {
     let mut p = points.to_vec();
     p.sort_by(|a, b| a.0.partial_cmp(&b.0).unwrap());
-    let u: Vec<f64> = p.iter().map(|x| x.0).collect();
-    let dp: Vec<f64> = p.iter().map(|x| x.1).collect();
-    save(&plot::trace_marked(&u, &dp, Some(weight), Some(umf)), path);
+    series_marked(&p, Some(weight), Some(umf), path);
 }
 
 /// A time series (t, y) with a red horizontal line at `level` (e.g. its expected or mean value).
 pub fn series_with_level(points: &[(f64, f64)], level: f64, path: &str) {
+    series_marked(points, Some(level), None, path);
+}
+
+fn series_marked(points: &[(f64, f64)], level: Option<f64>, at: Option<f64>, path: &str) {
     let t: Vec<f64> = points.iter().map(|x| x.0).collect();
     let y: Vec<f64> = points.iter().map(|x| x.1).collect();
-    save(&plot::trace_marked(&t, &y, Some(level), None), path);
+    save(&plot::trace_marked(&t, &y, level, at), path);
 }
 
 /// A cell field on the vertical plane through the axis.

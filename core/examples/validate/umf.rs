@@ -146,15 +146,10 @@ fn intersect(points: &[(f64, f64)], weight: f64) -> f64 {
 /// Voidage of the bed's core: particle volume between one diameter above the plate and one
 /// below the bed top, over the column's cross-section (wall zone included).
 fn core_voidage(sim: &fluidbed_core::sim::Simulation) -> f64 {
-    let d = 2.0 * sim.dem().radius();
-    let (lo, hi) = (d, bed_top_m(sim) - d);
-    // a sphere cut by a plane at height h above its centre keeps the cap volume below it
-    let part = |z: f64, cut: f64| -> f64 {
-        let r = d / 2.0;
-        let h = (cut - z).clamp(-r, r); // signed distance of the cut above the centre
-        std::f64::consts::PI * (r + h).powi(2) * (2.0 * r - h) / 3.0 // volume below the cut
-    };
-    let solid: f64 = sim.dem().positions().iter().map(|p| (part(p[2], hi) - part(p[2], lo)).max(0.0)).sum();
+    use fluidbed_core::coupling::voidage::sphere_box::sphere_slab_volume;
+    let r = sim.dem().radius();
+    let (lo, hi) = (2.0 * r, bed_top_m(sim) - 2.0 * r);
+    let solid: f64 = sim.dem().positions().iter().map(|p| sphere_slab_volume(p[2], r, lo, hi)).sum();
     let area = std::f64::consts::PI * (sim.case().column.diameter_m / 2.0).powi(2);
     1.0 - solid / (area * (hi - lo))
 }
