@@ -28,18 +28,36 @@ pub fn end_s() -> f64 {
     std::env::var("FLUIDBED_BUBBLING_END_S").ok().and_then(|s| s.parse().ok()).unwrap_or(2.0)
 }
 
-/// The run of cases/bubbling-44mm.json to `end_s`, from the cache or run now.
+/// The bubbling case: cases/bubbling-44mm.json, or the file `FLUIDBED_BUBBLING_CASE` names.
+pub fn case() -> fluidbed_core::case::Case {
+    match std::env::var("FLUIDBED_BUBBLING_CASE") {
+        Ok(path) => {
+            let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+            fluidbed_core::case::Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0
+        }
+        Err(_) => load_case("bubbling-44mm.json"),
+    }
+}
+
+/// FNV-1a hash of a text: names the cached run after the case it ran, so an edited case runs anew.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
+}
+
+/// The run of the bubbling case to `end_s`, from the cache or run now.
 pub fn run_to(end_s: f64) -> RunSummary {
-    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s.json");
+    let mut case = case();
+    case.end_time_s = end_s;
+    case.outputs.snapshot_interval_s = 0.005;
+    case.outputs.fields = vec![Field::Voidage, Field::Pressure];
+    let key = fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
+    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.json");
     let cache = cache.as_str();
     if let Some(r) = std::fs::read_to_string(cache).ok().and_then(|t| serde_json::from_str(&t).ok()) {
         eprintln!("using the run kept in {cache} (delete it to run again)");
         return r;
     }
-    let mut case = load_case("bubbling-44mm.json");
-    case.end_time_s = end_s;
-    case.outputs.snapshot_interval_s = 0.005;
-    case.outputs.fields = vec![Field::Voidage, Field::Pressure];
+    eprintln!("running the bubbling case to {end_s} s; it will be kept in {cache}");
     let t0 = std::time::Instant::now();
     let mut sim = fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build");
     let mut snaps = Vec::new();
@@ -51,10 +69,10 @@ pub fn run_to(end_s: f64) -> RunSummary {
             budget.push([s.time_s, plate, tube, dem.external_force_total()[2], dem.momentum()[2]]);
             if s.index % 10 == 0 {
                 eprintln!("[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s", s.time_s, s.pressure_drop_pa.unwrap_or(0.0), t0.elapsed().as_secs_f64());
-                // the ΔP series so far, in case the run is stopped early
+                // the ΔP series and budget so far, in case the run is stopped early
                 let dp: Vec<(f64, f64)> = snaps.iter().chain(std::iter::once(&s)).filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p))).collect();
                 std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-                std::fs::write(format!("{cache}.partial"), serde_json::to_string(&dp).unwrap()).expect("write partial");
+                std::fs::write(format!("{cache}.partial"), json!({"dp": dp, "budget": budget}).to_string()).expect("write partial");
             }
             snaps.push(s);
         }
@@ -87,7 +105,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
 
 pub fn run() -> serde_json::Value {
     let r = run_to(end_s());
-    let case = load_case("bubbling-44mm.json");
+    let case = case();
     let (weight, head) = crate::fluidized::expected_dp(&case, r.particles);
     let want = weight + head;
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= 0.4).map(|x| x.1).collect();

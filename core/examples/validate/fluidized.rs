@@ -5,7 +5,7 @@
 //! t = 0.4 s (after the 240-ms ramp and the first bubbles). It also prints the particles' momentum
 //! budget over the same window: weight = gas force + plate + tube − d(momentum)/dt.
 
-use crate::common::*;
+use crate::common::bed_weight_per_area;
 use serde_json::json;
 
 pub fn run() -> serde_json::Value {
@@ -14,7 +14,7 @@ pub fn run() -> serde_json::Value {
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= t_avg).map(|x| x.1).collect();
     let mean = tail.iter().sum::<f64>() / tail.len() as f64;
     let sd = (tail.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / tail.len() as f64).sqrt();
-    let case = load_case("bubbling-44mm.json");
+    let case = crate::bubbling::case();
     let (weight, head) = expected_dp(&case, r.particles);
     let want = weight + head;
     let rel = mean / want - 1.0;
