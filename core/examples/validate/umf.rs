@@ -58,12 +58,11 @@ pub fn run() -> serde_json::Value {
         case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
         case.voidage = fluidbed_core::case::Voidage::SquareGrid { box_side_m: None, split: fluidbed_core::case::BoxSplit::Cuboid, cube_side_factor: 1.0 };
     }
-    if sw.dz_over_dr != 1.0 {
-        case.grid.dz_m = Some(sw.dz_over_dr * case.grid.dr_m);
-    }
-    if sw.column_mm != 44.0 || sw.height_mm != 30.0 || sw.dz_over_dr != 1.0 {
+    let dz = sw.dz_over_dr * case.grid.dr_m;
+    let same_layers = case.grid.dz_m.map_or(sw.dz_over_dr == 1.0, |c| c == dz);
+    case.grid.dz_m = Some(dz);
+    if sw.column_mm != 44.0 || sw.height_mm != 30.0 || !same_layers {
         // a column three bed heights tall (at least 66 mm), a whole number of layers
-        let dz = case.grid.dz_m.unwrap_or(case.grid.dr_m);
         case.column.height_m = ((3.0 * sw.height_mm / 1000.0).max(0.066) / dz).round() * dz;
     }
     case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed { settled_height_m: Some(sw.height_mm / 1000.0), count: None, seed: sw.seed });
