@@ -59,9 +59,9 @@ pub fn run() -> serde_json::Value {
         case.voidage = fluidbed_core::case::Voidage::SquareGrid { box_side_m: None, split: fluidbed_core::case::BoxSplit::Cuboid, cube_side_factor: 1.0 };
     }
     let dz = sw.dz_over_dr * case.grid.dr_m;
-    let same_layers = case.grid.dz_m.map_or(sw.dz_over_dr == 1.0, |c| c == dz);
     case.grid.dz_m = Some(dz);
-    if sw.column_mm != 44.0 || sw.height_mm != 30.0 || !same_layers {
+    let layers = case.column.height_m / dz;
+    if sw.column_mm != 44.0 || sw.height_mm != 30.0 || (layers - layers.round()).abs() > 1e-9 {
         // a column three bed heights tall (at least 66 mm), a whole number of layers
         case.column.height_m = ((3.0 * sw.height_mm / 1000.0).max(0.066) / dz).round() * dz;
     }
