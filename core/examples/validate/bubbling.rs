@@ -31,17 +31,9 @@ pub fn end_s() -> f64 {
 /// The bubbling case: cases/bubbling-44mm.json, or the file `FLUIDBED_BUBBLING_CASE` names.
 pub fn case() -> fluidbed_core::case::Case {
     match std::env::var("FLUIDBED_BUBBLING_CASE") {
-        Ok(path) => {
-            let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
-            fluidbed_core::case::Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0
-        }
+        Ok(path) => load_case_path(&path),
         Err(_) => load_case("bubbling-44mm.json"),
     }
-}
-
-/// FNV-1a hash of a text: names the cached run after the case it ran, so an edited case runs anew.
-fn fnv1a(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| (h ^ b as u64).wrapping_mul(0x100_0000_01b3))
 }
 
 /// The run of the bubbling case to `end_s`, from the cache or run now.
@@ -50,7 +42,8 @@ pub fn run_to(end_s: f64) -> RunSummary {
     case.end_time_s = end_s;
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
-    let key = fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
+    // named after the case it ran, so an edited case runs anew
+    let key = fluidbed_core::dem::bed::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
     let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.json");
     let cache = cache.as_str();
     if let Some(r) = std::fs::read_to_string(cache).ok().and_then(|t| serde_json::from_str(&t).ok()) {

@@ -8,8 +8,12 @@ use std::time::Instant;
 
 /// A case from the project's cases/ folder.
 pub fn load_case(file: &str) -> Case {
-    let path = format!("{}/../cases/{file}", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    load_case_path(&format!("{}/../cases/{file}", env!("CARGO_MANIFEST_DIR")))
+}
+
+/// A case file anywhere.
+pub fn load_case_path(path: &str) -> Case {
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
     Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0
 }
 

@@ -232,7 +232,13 @@ pub fn cache_key(case: &Case) -> u64 {
         "skin": case.dem.skin_fraction,
     })
     .to_string();
-    what.bytes().fold(0xcbf29ce484222325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100000001b3))
+    fnv1a(&what)
+}
+
+/// FNV-1a hash of a text (stable across Rust releases, unlike `DefaultHasher`): names cached
+/// results after what made them.
+pub fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf29ce484222325u64, |h, b| (h ^ b as u64).wrapping_mul(0x100000001b3))
 }
 
 const MAGIC: &[u8; 8] = b"FBBED001";
