@@ -51,9 +51,9 @@ fn angle_of(x: f64, y: f64) -> (f64, f64) {
 pub struct Exchange {
     /// (cos θ_c, sin θ_c) of each in-layer cell's centre angle.
     cell_basis: Vec<(f64, f64)>,
-    /// Cell of each particle's centre and its drag (Cartesian), from the parallel pass.
+    /// Cell of each particle's centre and its drag in that cell's basis, from the parallel pass.
     cell_of: Vec<u32>,
-    drag: Vec<[f64; 3]>,
+    drag_cyl: Vec<[f64; 3]>,
     /// Frozen beds: per cell, particle count and Σcos, Σsin of (θ_p − θ_c) (see `frozen_cell_forces`).
     frozen: Vec<(f64, f64, f64)>,
     /// Beetstra's per-cell factors, refreshed each call.
@@ -112,7 +112,7 @@ impl Exchange {
                 cell_basis.push((th.cos(), th.sin()));
             }
         }
-        Exchange { cell_basis, cell_of: vec![0; particles], drag: vec![[0.0; 3]; particles], frozen: Vec::new(), cell_drag: Vec::new() }
+        Exchange { cell_basis, cell_of: vec![0; particles], drag_cyl: vec![[0.0; 3]; particles], frozen: Vec::new(), cell_drag: Vec::new() }
     }
 
     /// Fluid force on every particle (Cartesian, −V_p∇p + drag) into `force_out`, and the
@@ -136,38 +136,40 @@ impl Exchange {
         assert_eq!(pos.len(), force_out.len());
         assert_eq!(cell_force_out.len(), grid.num_cells());
         self.cell_of.resize(pos.len(), 0);
-        self.drag.resize(pos.len(), [0.0; 3]);
+        self.drag_cyl.resize(pos.len(), [0.0; 3]);
         let vp = PI * d * d * d / 6.0;
         self.cell_drag.resize(grid.num_cells(), CellDrag::default());
         for (c, cd) in self.cell_drag.iter_mut().enumerate() {
             *cd = CellDrag::new(mu, gas.density[c], d, gas.voidage[c], eps_min);
         }
-        let cell_drag = &self.cell_drag;
+        let (cell_drag, basis, per) = (&self.cell_drag, &self.cell_basis, grid.cells_per_layer());
         // 1. per particle (parallel): its cell, the drag, and the total force −V_p∇p + drag, with
-        //    the gas vectors turned to Cartesian at the particle's own angle (paper section 2.3)
-        (force_out, &mut self.drag[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
-            |((f, dr, co), (p, v))| {
-                let c = grid.locate(p[0], p[1], p[2]);
+        //    the gas vectors turned to Cartesian at the particle's own angle (paper section 2.3);
+        //    the drag also in the basis of its cell's centre, for the gas
+        (force_out, &mut self.drag_cyl[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
+            |((f, dc, co), (p, v))| {
+                let (i, j) = grid.locate_ij(p[0], p[1]);
+                let (lc, k) = (grid.layer_index(i, j), grid.locate_k(p[2]));
+                let c = k * per + lc;
                 let (cos, sin) = angle_of(p[0], p[1]);
                 let u = cyl_to_cart(gas.velocity_cyl[c], cos, sin);
                 let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
-                *dr = cell_drag[c].force(slip);
+                let dr = cell_drag[c].force(slip);
                 let g = cyl_to_cart(gas.grad_p_cyl[c], cos, sin);
                 *f = [dr[0] - vp * g[0], dr[1] - vp * g[1], dr[2] - vp * g[2]];
+                let (cc, sc) = basis[lc];
+                *dc = cart_to_cyl(dr, cc, sc);
                 *co = c as u32;
             },
         );
-        // 2. the gas loses the drag in the cell of the particle's centre, in that cell's basis
-        //    (serial, fixed order: deterministic)
+        // 2. the gas loses the drag in the cell of the particle's centre (serial, fixed order:
+        //    deterministic)
         cell_force_out.iter_mut().for_each(|f| *f = [0.0; 3]);
         let inv_v = 1.0 / grid.cell_volume();
-        let per = grid.cells_per_layer();
-        for (dr, &c) in self.drag.iter().zip(&self.cell_of) {
-            let c = c as usize;
-            let (cos, sin) = self.cell_basis[c % per];
-            let fc = cart_to_cyl(*dr, cos, sin);
+        for (fc, &c) in self.drag_cyl.iter().zip(&self.cell_of) {
+            let out = &mut cell_force_out[c as usize];
             for m in 0..3 {
-                cell_force_out[c][m] -= fc[m] * inv_v;
+                out[m] -= fc[m] * inv_v;
             }
         }
     }
