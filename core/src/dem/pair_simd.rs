@@ -64,11 +64,12 @@ pub unsafe fn scan8<const FR: bool>(
 }
 
 /// Lanes l..l+8 of `batch` (those in `valid`): v_i − v_j, R(ω_i + ω_j) and, for lanes whose
-/// history is live, the history `shear[k − base]` (zero otherwise).
+/// history is live, the history `shear[k − base]` (zero otherwise). Panics unless every valid
+/// lane has i, j < v.len() (and w.len() when FR) and base ≤ k < base + shear.len().
 ///
 /// # Safety
-/// The CPU has avx512f, avx512vl and bmi2; l + 8 ≤ CAP; for the valid lanes i, j < v.len()
-/// (and w.len() when FR), base ≤ k < base + shear.len(); v.len() ≤ i32::MAX / 3.
+/// The CPU has avx512f, avx512vl and bmi2; l + 8 ≤ CAP; v.len(), w.len() and shear.len() are
+/// at most i32::MAX / 3.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 #[allow(clippy::too_many_arguments)]
@@ -79,6 +80,9 @@ pub unsafe fn gather8<const FR: bool>(
     let three = |a: __m256i| _mm256_add_epi32(_mm256_add_epi32(a, a), a);
     let oi = _mm256_loadu_si256(batch.i.as_ptr().add(l) as *const __m256i);
     let oj = _mm256_loadu_si256(batch.j.as_ptr().add(l) as *const __m256i);
+    let below = |a: __m256i, n: usize| _mm256_cmplt_epu32_mask(a, _mm256_set1_epi32(n as i32));
+    let nv = if FR { v.len().min(w.len()) } else { v.len() };
+    assert!(below(oi, nv) & below(oj, nv) & valid == valid, "pair index beyond the particles");
     let (ti, tj) = (three(oi), three(oj));
     let z = _mm512_setzero_pd();
     let vp = v.as_ptr() as *const f64;
@@ -92,6 +96,8 @@ pub unsafe fn gather8<const FR: bool>(
     }
     let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f64, _mm512_set1_pd(r));
     let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    // k < base wraps to a large unsigned value, so one compare checks both ends.
+    assert!(below(kk, shear.len()) & valid == valid, "history slot beyond the chunk");
     let tk = three(kk);
     const BYTES: u64 = 0x0101_0101_0101_0101;
     let live = valid & _pext_u64((batch.was.as_ptr().add(l) as *const u64).read_unaligned(), BYTES) as __mmask8;
