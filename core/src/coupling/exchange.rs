@@ -51,7 +51,8 @@ fn angle_of(x: f64, y: f64) -> (f64, f64) {
 pub struct Exchange {
     /// (cos θ_c, sin θ_c) of each in-layer cell's centre angle.
     cell_basis: Vec<(f64, f64)>,
-    /// Cell of each particle's centre and its drag in that cell's basis, from the parallel pass.
+    /// Cell of each particle's centre (also the next call's hint) and its drag in that cell's
+    /// basis, from the parallel pass.
     cell_of: Vec<u32>,
     drag_cyl: Vec<[f64; 3]>,
     /// Frozen beds: per cell, particle count and Σcos, Σsin of (θ_p − θ_c) (see `frozen_cell_forces`).
@@ -148,9 +149,10 @@ impl Exchange {
         //    the drag also in the basis of its cell's centre, for the gas
         (force_out, &mut self.drag_cyl[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
             |((f, dc, co), (p, v))| {
-                let (i, j) = grid.locate_ij(p[0], p[1]);
-                let (lc, k) = (grid.layer_index(i, j), grid.locate_k(p[2]));
-                let c = k * per + lc;
+                // The cell of the last call is a hint (particles move little; after a re-sort
+                // the hint is another particle's and `locate_near` falls back to `locate`).
+                let c = grid.locate_near(p[0], p[1], p[2], *co as usize);
+                let lc = c % per;
                 let (cos, sin) = angle_of(p[0], p[1]);
                 let u = cyl_to_cart(gas.velocity_cyl[c], cos, sin);
                 let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];

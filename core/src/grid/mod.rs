@@ -33,6 +33,26 @@ pub struct CylGrid {
     outer: Vec<RadialLink>,
     inner_start: Vec<usize>,
     inner: Vec<RadialLink>,
+    /// Per in-layer cell, the bounds `locate_near` tests a hint against.
+    sectors: Vec<Sector>,
+}
+
+/// Bounds of one in-layer cell, shrunk by a margin (`Sector::MARGIN`) far above the rounding
+/// of `locate`: r² strictly between `r2_lo` and `r2_hi`, and the point on the inner side of
+/// both edge directions `lo` and `hi` (unit vectors at θ_j and θ_{j+1}).
+#[derive(Clone, Copy, Debug)]
+struct Sector {
+    r2_lo: f64,
+    r2_hi: f64,
+    lo: (f64, f64),
+    hi: (f64, f64),
+    /// Sectors of half a turn or more are never tested (the edge test needs less).
+    usable: bool,
+}
+
+impl Sector {
+    /// Relative margin in r and angle (radians): 1e-9, against ~1e-15 of rounding in `locate`.
+    const MARGIN: f64 = 1e-9;
 }
 
 impl CylGrid {
@@ -57,6 +77,7 @@ impl CylGrid {
             outer: vec![],
             inner_start: vec![0],
             inner: vec![],
+            sectors: vec![],
         };
         for i in 0..nr {
             for j in 0..g.cells_in_annulus(i) {
@@ -68,9 +89,20 @@ impl CylGrid {
                     g.inner.extend(Self::overlaps(g.cells_in_annulus(i), j, g.cells_in_annulus(i - 1)));
                 }
                 g.inner_start.push(g.inner.len());
+                g.sectors.push(g.sector(i, j));
             }
         }
         g
+    }
+
+    fn sector(&self, i: usize, j: usize) -> Sector {
+        let m = Sector::MARGIN;
+        let (r0, r1) = (i as f64 * self.dr * (1.0 + m), (i + 1) as f64 * self.dr * (1.0 - m));
+        // The outer annulus also holds points beyond the wall (`locate_ij`).
+        let r2_hi = if i + 1 == self.nr { f64::INFINITY } else { r1 * r1 };
+        let (t0, t1) = self.theta_bounds(i, j);
+        let usable = self.cells_in_annulus(i) >= 3;
+        Sector { r2_lo: r0 * r0, r2_hi, lo: (t0.cos(), t0.sin()), hi: (t1.cos(), t1.sin()), usable }
     }
 
     /// Cells of an annulus with `m` cells that overlap cell j of an annulus with `n` cells, with the
@@ -162,6 +194,33 @@ impl CylGrid {
     pub fn locate(&self, x: f64, y: f64, z: f64) -> usize {
         let (i, j) = self.locate_ij(x, y);
         self.index(i, j, self.locate_k(z))
+    }
+    /// The cell holding (x, y, z), exactly as `locate`, trying the cell `hint` first (say, the
+    /// one the point was in before): when the point is inside the hint's bounds by the margin
+    /// (`Sector::MARGIN`, far above `locate`'s rounding), the hint is the answer and the square
+    /// root and atan2 are skipped; otherwise `locate` decides.
+    #[inline]
+    pub fn locate_near(&self, x: f64, y: f64, z: f64, hint: usize) -> usize {
+        if self.hint_holds(x, y, z, hint) {
+            hint
+        } else {
+            self.locate(x, y, z)
+        }
+    }
+    /// (x, y, z) is inside cell `hint` by the margin of `locate_near` (its layer as `locate`).
+    #[inline]
+    pub fn hint_holds(&self, x: f64, y: f64, z: f64, hint: usize) -> bool {
+        let per = self.cells_per_layer();
+        let c = hint.wrapping_sub(self.locate_k(z) * per);
+        if c >= per {
+            return false;
+        }
+        let s = &self.sectors[c];
+        let r2 = x * x + y * y;
+        // r × sin of the angle from each edge, positive inside.
+        let (a, b) = (s.lo.0 * y - s.lo.1 * x, x * s.hi.1 - y * s.hi.0);
+        let tol2 = Sector::MARGIN * Sector::MARGIN * r2;
+        s.usable && r2 > s.r2_lo && r2 < s.r2_hi && a > 0.0 && b > 0.0 && a * a > tol2 && b * b > tol2
     }
     /// Angular neighbours (j-1, j+1) of (i, j), periodic.
     pub fn angular_neighbours(&self, i: usize, j: usize) -> (usize, usize) {

@@ -4,15 +4,42 @@
 /// Most grid intervals one cube side may span (h ≤ 6 intervals).
 pub const MAX_SPAN: usize = 8;
 
-/// Shares of the interval [c − h/2, c + h/2] in the cells of a uniform 1D grid with `n` cells of
-/// width `dl` starting at `origin`. Parts beyond the ends go to the end cells (nothing is lost).
-/// Writes (cell, share) pairs into `out` and returns how many; the shares sum to 1 (exactly
-/// for the one- and two-cell cases, which are most of them when h is below the cell width).
-#[inline]
-pub fn interval_split(c: f64, h: f64, origin: f64, dl: f64, n: usize, out: &mut [(usize, f64); MAX_SPAN]) -> usize {
+/// A uniform 1D grid of `n` cells of width `dl` from `origin`, with 1/dl kept (cell lookups
+/// multiply instead of divide).
+#[derive(Clone, Copy, Debug)]
+pub struct Axis {
+    pub origin: f64,
+    pub dl: f64,
+    pub n: usize,
+    inv_dl: f64,
+}
+
+impl Axis {
+    pub fn new(origin: f64, dl: f64, n: usize) -> Axis {
+        Axis { origin, dl, n, inv_dl: 1.0 / dl }
+    }
+    /// Cell of coordinate x, clamped to [0, n).
+    #[inline(always)]
+    pub fn cell(&self, x: f64) -> usize {
+        let f = (x - self.origin) * self.inv_dl;
+        if f <= 0.0 {
+            0
+        } else {
+            (f as usize).min(self.n - 1)
+        }
+    }
+}
+
+/// Shares of the interval [c − h/2, c + h/2] in the cells of `axis`. Parts beyond the ends go
+/// to the end cells (nothing is lost). Writes (cell, share) pairs into `out` and returns how
+/// many; the shares sum to 1 (exactly for the one- and two-cell cases, which are most of them
+/// when h is below the cell width).
+#[inline(always)]
+pub fn interval_split(c: f64, h: f64, axis: &Axis, out: &mut [(usize, f64); MAX_SPAN]) -> usize {
+    let Axis { origin, dl, n, .. } = *axis;
     let (a, b) = (c - h / 2.0, c + h / 2.0);
-    let first = cell_of(a, origin, dl, n);
-    let last = cell_of(b, origin, dl, n);
+    let first = axis.cell(a);
+    let last = axis.cell(b);
     if first == last {
         out[0] = (first, 1.0);
         return 1;
@@ -42,6 +69,19 @@ pub fn interval_split(c: f64, h: f64, origin: f64, dl: f64, n: usize, out: &mut 
     m
 }
 
+/// `interval_split` when h ≤ the cell width: the interval lies in at most two cells, given as
+/// two (cell, share) pairs (the second share 0 when it fits in one cell), without branches.
+#[inline(always)]
+pub fn split_two(c: f64, h: f64, axis: &Axis) -> [(usize, f64); 2] {
+    debug_assert!(h <= axis.dl);
+    let a = c - h / 2.0;
+    let first = axis.cell(a);
+    let plane = axis.origin + (first + 1) as f64 * axis.dl;
+    // The last cell reaches to +∞.
+    let share = if first + 1 == axis.n { 1.0 } else { ((plane - a) / h).clamp(0.0, 1.0) };
+    [(first, share), ((first + 1).min(axis.n - 1), 1.0 - share)]
+}
+
 /// Cell of coordinate x on the grid, clamped to [0, n).
 #[inline]
 pub fn cell_of(x: f64, origin: f64, dl: f64, n: usize) -> usize {
@@ -64,18 +104,19 @@ mod tests {
         let mut out = [(0, 0.0); MAX_SPAN];
         for k in 0..1000 {
             let c = -0.3 + 0.0057 * k as f64;
-            let m = interval_split(c, 1.2, 0.0, 1.375, 4, &mut out);
+            let m = interval_split(c, 1.2, &Axis::new(0.0, 1.375, 4), &mut out);
             let s: f64 = out[..m].iter().map(|e| e.1).sum();
             assert!((s - 1.0).abs() < 1e-14);
         }
         // a cube centred in a cell larger than d: f = 1
-        let m = interval_split(2.0, 1.2, 0.0, 4.4, 3, &mut out);
+        let m = interval_split(2.0, 1.2, &Axis::new(0.0, 4.4, 3), &mut out);
         assert_eq!((m, out[0].0), (1, 0));
         assert!((out[0].1 - 1.0).abs() < 1e-15);
     }
 
     /// Every share is the overlap length of [c − h/2, c + h/2] with its cell over h (end cells
-    /// reaching to ±∞), for cubes inside one cell, across one face and across several.
+    /// reaching to ±∞), for cubes inside one cell, across one face and across several; the
+    /// same for `split_two` where h ≤ dl.
     #[test]
     fn shares_are_the_overlap_lengths() {
         let (origin, n) = (-0.5, 6);
@@ -83,13 +124,19 @@ mod tests {
             for k in 0..2000 {
                 let c = -1.5 + 0.00371 * k as f64;
                 let mut out = [(0, 0.0); MAX_SPAN];
-                let m = interval_split(c, h, origin, dl, n, &mut out);
+                let axis = Axis::new(origin, dl, n);
+                let m = interval_split(c, h, &axis, &mut out);
+                let two = if h <= dl { split_two(c, h, &axis) } else { [(0, 0.0); 2] };
                 for cell in 0..n {
                     let lo = if cell == 0 { f64::NEG_INFINITY } else { origin + cell as f64 * dl };
                     let hi = if cell + 1 == n { f64::INFINITY } else { origin + (cell + 1) as f64 * dl };
                     let want = ((c + h / 2.0).min(hi) - (c - h / 2.0).max(lo)).max(0.0) / h;
                     let got: f64 = out[..m].iter().filter(|e| e.0 == cell).map(|e| e.1).sum();
                     assert!((got - want).abs() < 1e-12, "dl {dl} c {c} cell {cell}: {got} vs {want}");
+                    if h <= dl {
+                        let got: f64 = two.iter().filter(|e| e.0 == cell).map(|e| e.1).sum();
+                        assert!((got - want).abs() < 1e-12, "split_two: dl {dl} c {c} cell {cell}: {got} vs {want}");
+                    }
                 }
             }
         }
