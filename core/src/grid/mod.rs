@@ -209,7 +209,7 @@ impl CylGrid {
     }
     /// (x, y, z) is inside cell `hint` by the margin of `locate_near` (its layer as `locate`).
     #[inline]
-    pub fn hint_holds(&self, x: f64, y: f64, z: f64, hint: usize) -> bool {
+    pub(crate) fn hint_holds(&self, x: f64, y: f64, z: f64, hint: usize) -> bool {
         let per = self.cells_per_layer();
         let c = hint.wrapping_sub(self.locate_k(z) * per);
         if c >= per {

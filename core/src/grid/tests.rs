@@ -57,14 +57,19 @@ fn shared_face_areas_agree_from_both_sides() {
     }
 }
 
+/// Uniform numbers in [0, 1) from a seeded LCG (reproducible, no dependency).
+fn uniform(seed: u64) -> impl FnMut() -> f64 {
+    let mut s = seed;
+    move || {
+        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (s >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 #[test]
 fn locate_finds_the_cell_whose_bounds_hold_the_point() {
     let g = paper_grid();
-    let mut s = 12345u64;
-    let mut rnd = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rnd = uniform(12345);
     for _ in 0..10_000 {
         let r = g.radius * rnd().sqrt();
         let th = 2.0 * PI * rnd();
@@ -93,11 +98,7 @@ fn ijk_round_trips() {
 #[test]
 fn locate_near_agrees_with_locate_for_any_hint() {
     let g = paper_grid();
-    let mut s = 777u64;
-    let mut rnd = || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-        (s >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut rnd = uniform(777);
     let (mut taken, mut total) = (0, 0);
     for n in 0..40_000 {
         let (mut r, mut th, z) = (g.radius * 1.02 * rnd().sqrt(), 2.0 * PI * rnd(), g.height * rnd());

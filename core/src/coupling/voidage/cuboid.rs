@@ -32,25 +32,12 @@ impl Axis {
 
 /// Shares of the interval [c − h/2, c + h/2] in the cells of `axis`. Parts beyond the ends go
 /// to the end cells (nothing is lost). Writes (cell, share) pairs into `out` and returns how
-/// many; the shares sum to 1 (exactly for the one- and two-cell cases, which are most of them
-/// when h is below the cell width).
-#[inline(always)]
+/// many; the shares sum to 1. (`split_two` is the branch-free form for h ≤ dl.)
 pub fn interval_split(c: f64, h: f64, axis: &Axis, out: &mut [(usize, f64); MAX_SPAN]) -> usize {
     let Axis { origin, dl, n, .. } = *axis;
     let (a, b) = (c - h / 2.0, c + h / 2.0);
     let first = axis.cell(a);
     let last = axis.cell(b);
-    if first == last {
-        out[0] = (first, 1.0);
-        return 1;
-    }
-    if last == first + 1 {
-        // One plane inside the interval (an inner face: both cells are not clamped there).
-        let share = ((origin + last as f64 * dl - a) / h).clamp(0.0, 1.0);
-        out[0] = (first, share);
-        out[1] = (last, 1.0 - share);
-        return 2;
-    }
     assert!(last - first < MAX_SPAN, "cube side spans more than {MAX_SPAN} grid intervals");
     let mut m = 0;
     for cell in first..=last {
@@ -82,16 +69,6 @@ pub fn split_two(c: f64, h: f64, axis: &Axis) -> [(usize, f64); 2] {
     [(first, share), ((first + 1).min(axis.n - 1), 1.0 - share)]
 }
 
-/// Cell of coordinate x on the grid, clamped to [0, n).
-#[inline]
-pub fn cell_of(x: f64, origin: f64, dl: f64, n: usize) -> usize {
-    let f = (x - origin) / dl;
-    if f <= 0.0 {
-        0
-    } else {
-        (f as usize).min(n - 1)
-    }
-}
 
 #[cfg(test)]
 mod tests {

@@ -9,7 +9,7 @@
 //! the smooth ∫A_c dt (tested against lattice sampling). A sphere wholly inside one cell (the most
 //! common case) costs one point location, and a slice wholly inside one cell needs no area work.
 
-use super::cuboid::cell_of;
+use super::cuboid::Axis;
 use super::polar_area::disk_cell_area;
 use super::sphere_box::sphere_slab_volume;
 use super::{Scatter, VoidageMethod};
@@ -66,7 +66,8 @@ fn disk_inside_cell(g: &CylGrid, x: f64, y: f64, rho: f64, i: usize, j: usize) -
 fn split_sphere(g: &CylGrid, nodes: &[(f64, f64)], p: &[f64; 3], a: f64, out: &mut [f64], cells: &mut Vec<(usize, f64)>) {
     let vp = 4.0 / 3.0 * PI * a * a * a;
     let (i, j) = g.locate_ij(p[0], p[1]);
-    let (k0, k1) = (cell_of(p[2] - a, 0.0, g.dz, g.nz), cell_of(p[2] + a, 0.0, g.dz, g.nz));
+    let layers = Axis::new(0.0, g.dz, g.nz);
+    let (k0, k1) = (layers.cell(p[2] - a), layers.cell(p[2] + a));
     let per = g.cells_per_layer();
     if disk_inside_cell(g, p[0], p[1], a, i, j) {
         // horizontally whole: only the exact split over layers

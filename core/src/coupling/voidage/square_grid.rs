@@ -3,7 +3,7 @@
 //! or exactly (PHYSICS.md 3), then mapped to the cells with the box→cell fractions of `BoxGrid`.
 
 use super::box_grid::BoxGrid;
-use super::cuboid::{cell_of, interval_split, split_two, Axis, MAX_SPAN};
+use super::cuboid::{interval_split, split_two, Axis, MAX_SPAN};
 use super::sphere_box::sphere_box_volume;
 use super::{Scatter, VoidageMethod};
 use crate::case::BoxSplit;
@@ -160,7 +160,10 @@ fn exact_particle(g: &CylGrid, bg: &BoxGrid, p: &[f64; 3], radius: f64, out: &mu
         let hi = if idx + 1 == n { f64::INFINITY } else { origin + (idx + 1) as f64 * dl };
         (lo, hi)
     };
-    let span = |x: f64, origin: f64, dl: f64, n: usize| (cell_of(x - radius, origin, dl, n), cell_of(x + radius, origin, dl, n));
+    let span = |x: f64, origin: f64, dl: f64, n: usize| {
+        let axis = Axis::new(origin, dl, n);
+        (axis.cell(x - radius), axis.cell(x + radius))
+    };
     let (x0, x1) = span(p[0], bg.origin, bg.dl, bg.nb);
     let (y0, y1) = span(p[1], bg.origin, bg.dl, bg.nb);
     let (z0, z1) = span(p[2], 0.0, g.dz, g.nz);
