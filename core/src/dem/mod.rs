@@ -3,6 +3,7 @@
 //! - `contact`: the contact law (PHYSICS.md 2), one kernel for pairs and walls;
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
+//! - `near_list`: the Verlet list's entries within a small gap, the list the pair pass walks;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
 //! - `pair_simd`: AVX-512 scan and gather of the pair pass, eight entries at a time;
 //! - `walls`: plate, tube and lid contacts for the particles near them;
@@ -16,6 +17,7 @@ pub mod bed;
 pub mod contact;
 pub mod forces;
 pub mod integrator;
+pub mod near_list;
 pub mod neighbors;
 pub mod pair_batch;
 pub mod particle_pass;
@@ -64,6 +66,22 @@ pub struct DemParams {
 }
 
 impl DemParams {
+    /// Gap below which a Verlet-list entry joins the near list: 0.15 of the skin (0.1 and 0.2 run
+    /// the DEM bench at the same speed, 7% faster than the whole list).
+    pub fn near_gap(&self) -> f64 {
+        0.15 * self.skin
+    }
+    /// Displacement since the near-list refresh that triggers the next one: just under half the
+    /// near gap (the 2% margin covers rounding in the distance checks).
+    pub fn near_move(&self) -> f64 {
+        0.49 * self.near_gap()
+    }
+    /// Displacement since the Verlet-list build beyond which a refresh rebuilds the list first:
+    /// just under (skin − near gap)/2, so the list holds every pair closer than d + near gap.
+    pub fn outer_move(&self) -> f64 {
+        0.49 * (self.skin - self.near_gap())
+    }
+
     pub fn new(case: &Case) -> Self {
         let r = case.particles.diameter_m / 2.0;
         let m = case.particle_mass_kg();

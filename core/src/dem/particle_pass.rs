@@ -91,7 +91,8 @@ pub struct Motion<'a> {
     pub v: &'a mut [V3],
     pub w: &'a mut [V3],
     pub past: &'a mut Past,
-    pub x_build: &'a [V3],
+    /// Positions the largest displacement is measured from (the last near-list refresh).
+    pub x_ref: &'a [V3],
     pub walls: &'a mut WallList,
 }
 
@@ -133,9 +134,9 @@ pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: 
         let older = [ov.next().unwrap(), oa.next().unwrap(), ow.next().unwrap()];
         work.push(BlockMotion { lo: b * BLOCK, x, v, w, newer: [a0, a1, a2], older, widx, whist });
     }
-    let x_build = m.x_build;
+    let x_ref = m.x_ref;
     work.into_par_iter()
-        .map(|bm| update_block_dispatch::<FR>(p, hb, bm, x_build, ext, sc))
+        .map(|bm| update_block_dispatch::<FR>(p, hb, bm, x_ref, ext, sc))
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
@@ -176,7 +177,7 @@ fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f
 }
 
 #[inline(always)]
-fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_build: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_ref: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
     let len = x.len();
     let mut st = Stats::ZERO;
@@ -197,10 +198,10 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al[..len].as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
     }
-    // Largest squared displacement since the list build, as eight partial maxima (a vector
+    // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).
     let mut part = [0.0f64; 8];
-    for (l, (xn, xb)) in x.iter().zip(&x_build[lo..lo + len]).enumerate() {
+    for (l, (xn, xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
         let dd = [xn[0] - xb[0], xn[1] - xb[1], xn[2] - xb[2]];
         let d2 = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
         part[l % 8] = if d2 > part[l % 8] { d2 } else { part[l % 8] };

@@ -1,11 +1,13 @@
 //! `DemSystem`: the particle state (structure of arrays) and the step loop.
-//! A step is: pair pass → fused particle pass (walls, gravity, external force, AB update) →
-//! neighbour-list rebuild with re-sort when any particle moved more than skin/2.
+//! A step is: pair pass over the near list → fused particle pass (walls, gravity, external
+//! force, AB update) → near-list refresh when any particle moved more than about half the near
+//! gap, with a Verlet-list rebuild and re-sort first if the list could miss a near pair.
 
 use super::contact::V3;
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
 use super::particle_pass::{accel_pass, update_pass, Motion};
 use super::integrator::weights;
+use super::near_list::NearList;
 use super::neighbors::{build_list, cell_order, NeighborList};
 use super::walls::WallList;
 use super::DemParams;
@@ -22,11 +24,15 @@ pub struct DemSystem {
     pub(super) past: Past,
     /// Slot of `past` holding the newer values.
     ring: u8,
-    /// Positions at the last neighbour-list build.
+    /// Positions at the last Verlet-list build and at the last near-list refresh.
     x_build: Vec<V3>,
+    x_near: Vec<V3>,
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
-    pub(super) nl: NeighborList,
+    /// The Verlet list (skin `p.skin`) and the near list drawn from it, which holds the live
+    /// contact histories.
+    pub(super) outer: NeighborList,
+    pub(super) near: NearList,
     pub(super) walls: WallList,
     /// Derivative levels held for the multistep scheme: 0 → Heun next, 2 → AB2, 3 → AB3.
     levels: u8,
@@ -34,6 +40,8 @@ pub struct DemSystem {
     time: f64,
     frozen: bool,
     rebuild_due: bool,
+    /// Verlet-list builds and near-list refreshes so far (diagnostics).
+    builds: (u64, u64),
     last: (f64, f64),
     #[serde(skip)]
     sc_threads: usize,
@@ -59,15 +67,18 @@ impl DemSystem {
             past: Past::zeros(n),
             ring: 0,
             x_build: Vec::new(),
+            x_near: Vec::new(),
             ext: vec![[0.0; 3]; n],
             ids: (0..n as u32).collect(),
-            nl: NeighborList::default(),
+            outer: NeighborList::default(),
+            near: NearList::default(),
             walls: WallList::default(),
             levels: 0,
             steps: 0,
             time: 0.0,
             frozen: false,
             rebuild_due: false,
+            builds: (0, 0),
             last: (0.0, f64::NEG_INFINITY),
             sc_threads: 0,
             sc: Scratch::default(),
@@ -111,6 +122,10 @@ impl DemSystem {
     pub fn steps(&self) -> u64 {
         self.steps
     }
+    /// Verlet-list builds and near-list refreshes (without a build) so far.
+    pub fn list_builds(&self) -> (u64, u64) {
+        self.builds
+    }
     pub fn is_frozen(&self) -> bool {
         self.frozen
     }
@@ -133,8 +148,9 @@ impl DemSystem {
         let (r, x) = (self.p.radius, &self.x);
         let mut e = 0.0;
         for i in 0..x.len() {
-            for k in self.nl.offsets[i] as usize..self.nl.offsets[i + 1] as usize {
-                let j = self.nl.nbr[k] as usize;
+            let nl = &self.near.list;
+            for k in nl.offsets[i] as usize..nl.offsets[i + 1] as usize {
+                let j = nl.nbr[k] as usize;
                 let d = ((0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum::<f64>()).sqrt();
                 e += self.p.pair.elastic_energy((2.0 * r - d).max(0.0));
             }
@@ -191,10 +207,10 @@ impl DemSystem {
     fn advance<const FR: bool>(&mut self) {
         let chunks = if self.p.work_chunks > 0 { self.p.work_chunks } else { 2 * rayon::current_num_threads() };
         if self.sc.bounds.is_empty() || self.sc_threads != chunks {
-            self.sc = Scratch::plan(&self.nl, self.x.len(), chunks);
+            self.sc = Scratch::plan(&self.near.list, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, Kernels::Best);
+        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
         let st2 = if self.levels == 0 {
             self.heun::<FR>()
         } else {
@@ -206,7 +222,7 @@ impl DemSystem {
                 v: &mut self.v,
                 w: &mut self.w,
                 past: &mut self.past,
-                x_build: &self.x_build,
+                x_ref: &self.x_near,
                 walls: &mut self.walls,
             };
             let st = update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, &self.sc);
@@ -216,12 +232,31 @@ impl DemSystem {
         };
         let st = st1.max(st2);
         self.last = (st.overlap, st.coulomb_excess);
-        if st.disp2 > 0.25 * self.p.skin * self.p.skin {
-            self.rebuild_due = true;
+        if st.disp2 > self.p.near_move() * self.p.near_move() {
+            self.refresh();
         }
         if self.rebuild_due {
             self.rebuild();
         }
+    }
+
+    /// Redraw the near list from the Verlet list, rebuilding that first if a particle has moved
+    /// far enough since its build that it might miss a pair closer than d + near gap.
+    fn refresh(&mut self) {
+        let reach = self.p.outer_move();
+        let moved = self.x.iter().zip(&self.x_build).any(|(a, b)| {
+            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > reach * reach
+        });
+        if moved {
+            self.rebuild_due = true;
+            return;
+        }
+        self.near.write_back(&mut self.outer);
+        self.near = NearList::select(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap());
+        self.sc = Scratch::default();
+        self.x_near = self.x.clone();
+        self.builds.1 += 1;
     }
 
     /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
@@ -232,17 +267,18 @@ impl DemSystem {
         let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
         let st = accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d0);
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
-        let (shear1, touch1, walls1) = (self.nl.shear.clone(), self.nl.touch.clone(), self.walls.clone());
+        let nl = &self.near.list;
+        let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
         let step = |y: &V3, f: &[f64], c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
         for i in 0..n {
             self.x[i] = step(&x0[i], &v0[i], h);
             self.v[i] = step(&v0[i], &d0[i][..3], h);
             self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.nl, &mut self.sc, Kernels::Best);
+        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
         accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
-        (self.nl.shear, self.nl.touch, self.walls) = (shear1, touch1, walls1);
+        (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
         let mut disp2: f64 = 0.0;
         let newer = 1 - self.ring as usize;
         for i in 0..n {
@@ -256,7 +292,7 @@ impl DemSystem {
             q.v[newer][i] = v0[i];
             q.a[newer][i] = [d0[i][0], d0[i][1], d0[i][2]];
             q.alpha[newer][i] = [d0[i][3], d0[i][4], d0[i][5]];
-            let xb = self.x_build[i];
+            let xb = self.x_near[i];
             let d: f64 = (0..3).map(|k| (self.x[i][k] - xb[k]).powi(2)).sum();
             disp2 = disp2.max(d);
         }
@@ -273,7 +309,8 @@ impl DemSystem {
         self.rebuild();
     }
 
-    /// Re-sort particles by linked cell, rebuild the half list, carry contact history by id.
+    /// Re-sort particles by linked cell, rebuild the Verlet list, carry contact history by id,
+    /// draw the near list.
     fn rebuild(&mut self) {
         let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
         let perm = |src: &Vec<V3>| -> Vec<V3> { order.iter().map(|&o| src[o as usize]).collect() };
@@ -284,15 +321,19 @@ impl DemSystem {
         self.past.permute(&order);
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
-        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, 2.0 * self.p.radius);
+        let diameter = 2.0 * self.p.radius;
+        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
         if self.p.friction {
-            nl.carry_history(&self.nl, &old_ids, &self.ids);
+            nl.carry_history(&self.near.list, &old_ids, &self.ids);
         }
-        self.nl = nl;
+        self.near = NearList::select(&nl, &self.x, diameter, self.p.near_gap());
+        self.outer = nl;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc = Scratch::default();
         self.x_build = self.x.clone();
+        self.x_near = self.x.clone();
         self.rebuild_due = false;
+        self.builds.0 += 1;
     }
 }

@@ -110,13 +110,13 @@ fn vector_pair_pass_equals_the_portable_one() {
         sys.step(); // live histories
     }
     // Stale histories behind flags that say "not live" must be ignored: random both.
-    for (s, t) in sys.nl.shear.iter_mut().zip(sys.nl.touch.iter_mut()) {
+    for (s, t) in sys.near.list.shear.iter_mut().zip(sys.near.list.touch.iter_mut()) {
         *s = [1e-6 * rng.gen::<f64>(), -1e-6 * rng.gen::<f64>(), 1e-7];
         *t = rng.gen::<bool>() as u8;
     }
     let p = sys.p.clone();
     let run = |kernels: Kernels| {
-        let mut nl = sys.nl.clone();
+        let mut nl = sys.near.list.clone();
         let mut sc = Scratch::plan(&nl, sys.x.len(), 3);
         let st = pair_pass::<true>(&p, &sys.x, &sys.v, &sys.w, &mut nl, &mut sc, kernels);
         (st.overlap, st.coulomb_excess, sc.acc, nl.touch, nl.shear)

@@ -37,7 +37,7 @@ fn same_state(a: &DemSystem, b: &DemSystem) -> bool {
         && a.positions() == b.positions()
         && a.velocities() == b.velocities()
         && a.angular_velocities() == b.angular_velocities()
-        && a.nl.shear == b.nl.shear
+        && a.near.list.shear == b.near.list.shear
 }
 
 #[test]

@@ -5,6 +5,7 @@ mod batch_kernel;
 mod checkpoint;
 mod energy;
 mod integrator_order;
+mod near_list;
 mod poured_bed;
 mod restitution;
 mod sliding;

@@ -1,0 +1,107 @@
+//! The near list (`near_list`): it holds every touching pair at every step of a fast,
+//! colliding run (checked by brute force over all pairs), and a pair pass over it gives the
+//! whole Verlet list's forces, flags and histories bit for bit.
+
+use super::energy::random_gas;
+use super::{test_case, with_damping};
+use crate::dem::forces::{pair_pass, Kernels, Scratch};
+use crate::dem::DemSystem;
+use std::collections::HashSet;
+
+/// Pairs (i < j) listed in the near list now.
+fn near_pairs(s: &DemSystem) -> HashSet<(u32, u32)> {
+    let nl = &s.near.list;
+    let mut set = HashSet::new();
+    for i in 0..s.len() {
+        for &j in &nl.nbr[nl.offsets[i] as usize..nl.offsets[i + 1] as usize] {
+            set.insert((i as u32, j));
+        }
+    }
+    set
+}
+
+#[test]
+fn near_list_holds_every_touching_pair() {
+    // 400 particles at up to 1.5 m/s under gravity in a closed column: they cross the near gap
+    // (0.045 d) in about 30 steps, so the run refreshes and rebuilds many times.
+    let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
+    let d = case.particles.diameter_m;
+    let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
+    let mut s = DemSystem::new(&case, x, v);
+    let mut touching_seen = 0;
+    for _ in 0..2000 {
+        s.step();
+        let listed = near_pairs(&s);
+        let x = s.positions();
+        for i in 0..x.len() {
+            for j in i + 1..x.len() {
+                let r2: f64 = (0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum();
+                if r2 < d * d {
+                    touching_seen += 1;
+                    assert!(listed.contains(&(i as u32, j as u32)), "touching pair ({i}, {j}) missing at step {}", s.steps());
+                }
+            }
+        }
+    }
+    let (builds, refreshes) = s.list_builds();
+    eprintln!("{builds} builds, {refreshes} refreshes, {touching_seen} touching pair-steps");
+    assert!(builds >= 5 && refreshes >= 20, "{builds} Verlet builds, {refreshes} refreshes");
+    assert!(touching_seen > 20_000, "only {touching_seen} touching pair-steps");
+}
+
+#[test]
+fn near_list_pair_pass_equals_the_whole_lists() {
+    // Jittered lattice at contact: pairs touching, pairs within the near gap, pairs beyond it.
+    let case = with_damping(test_case(0.02, 0.03, false, 9.81, 1e-6), 0.1, 0.05, 0.3);
+    let d = case.particles.diameter_m;
+    let mut x = Vec::new();
+    let mut k = 0u64;
+    let mut jitter = || {
+        k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        0.06 * d * ((k >> 11) as f64 / (1u64 << 53) as f64 - 0.5)
+    };
+    for iz in 0..10 {
+        for iy in -6..=6 {
+            for ix in -6..=6 {
+                let p = [ix as f64 * d, iy as f64 * d, d + iz as f64 * d];
+                if (p[0] * p[0] + p[1] * p[1]).sqrt() < 0.0095 - d {
+                    x.push([p[0] + jitter(), p[1] + jitter(), p[2] + jitter()]);
+                }
+            }
+        }
+    }
+    let v: Vec<[f64; 3]> = (0..x.len()).map(|i| [0.05 * (i % 7) as f64, -0.03 * (i % 5) as f64, 0.0]).collect();
+    let mut s = DemSystem::new(&case, x, v);
+    for w in s.w.iter_mut() {
+        *w = [200.0, -100.0, 50.0];
+    }
+    for _ in 0..5 {
+        s.step(); // live histories
+    }
+    let mut outer = s.outer.clone();
+    s.near.write_back(&mut outer);
+    let n = s.len();
+    let run = |nl: &mut crate::dem::neighbors::NeighborList| {
+        let mut sc = Scratch::plan(nl, n, 1);
+        pair_pass::<true>(&s.p, &s.x, &s.v, &s.w, nl, &mut sc, Kernels::Best);
+        let mut acc = sc.acc;
+        acc.resize(n, [0.0; 6]);
+        acc
+    };
+    let mut near = s.near.list.clone();
+    let (on_near, on_outer) = (run(&mut near), run(&mut outer));
+    let touching = near.touch.iter().filter(|&&t| t == 1).count();
+    assert!(touching > 500 && touching < near.nbr.len(), "{touching} of {} near entries touch", near.nbr.len());
+    assert!(near.nbr.len() < outer.nbr.len(), "the near list is the whole list");
+    let bits = |a: &[[f64; 6]]| a.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    assert!(bits(&on_near) == bits(&on_outer), "forces and torques differ");
+    // Every entry left out of the near list does not touch; the kept ones agree exactly.
+    let kept: HashSet<u32> = s.near.src.iter().copied().collect();
+    for k in 0..outer.nbr.len() {
+        assert!(kept.contains(&(k as u32)) || outer.touch[k] == 0, "entry {k} touches but was left out");
+    }
+    for (e, &k) in s.near.src.iter().enumerate() {
+        assert_eq!(near.touch[e], outer.touch[k as usize]);
+        assert!(near.shear[e].map(f64::to_bits) == outer.shear[k as usize].map(f64::to_bits), "history of entry {k}");
+    }
+}
