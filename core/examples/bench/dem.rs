@@ -122,7 +122,13 @@ pub fn run() {
             }
             let secs = t0.elapsed().as_secs_f64();
             let rate = sys.len() as f64 * timed as f64 / secs;
-            eprintln!("dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d", secs, sys.kinetic_energy(), sys.max_overlap_fraction());
+            let (builds, refreshes) = sys.list_builds();
+            eprintln!(
+                "dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes",
+                secs,
+                sys.kinetic_energy(),
+                sys.max_overlap_fraction()
+            );
             println!(
                 "{{\"bench\":\"dem\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",
                 sys.len(),
