@@ -7,7 +7,7 @@ use super::contact::V3;
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
 use super::particle_pass::{accel_pass, update_pass, Motion};
 use super::integrator::weights;
-use super::near_list::NearList;
+use super::near_list::{Histories, NearList};
 use super::neighbors::{build_list, cell_order, NeighborList};
 use super::walls::WallList;
 use super::DemParams;
@@ -43,6 +43,9 @@ pub struct DemSystem {
     /// Verlet-list builds and near-list refreshes so far (diagnostics).
     builds: (u64, u64),
     last: (f64, f64),
+    /// Storage reused by near-list refreshes (the previous list's, and a flag per entry).
+    #[serde(skip)]
+    spare: (NearList, Vec<u8>),
     #[serde(skip)]
     sc_threads: usize,
     /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
@@ -80,6 +83,7 @@ impl DemSystem {
             rebuild_due: false,
             builds: (0, 0),
             last: (0.0, f64::NEG_INFINITY),
+            spare: Default::default(),
             sc_threads: 0,
             sc: Scratch::default(),
         };
@@ -207,7 +211,7 @@ impl DemSystem {
     fn advance<const FR: bool>(&mut self) {
         let chunks = if self.p.work_chunks > 0 { self.p.work_chunks } else { 2 * rayon::current_num_threads() };
         if self.sc.bounds.is_empty() || self.sc_threads != chunks {
-            self.sc = Scratch::plan(&self.near.list, self.x.len(), chunks);
+            self.sc.replan(&self.near.list, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
         let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
@@ -252,10 +256,11 @@ impl DemSystem {
             self.rebuild_due = true;
             return;
         }
-        self.near.write_back(&mut self.outer);
-        self.near = NearList::select(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap());
-        self.sc = Scratch::default();
-        self.x_near = self.x.clone();
+        let (spare, keep) = &mut self.spare;
+        spare.select_into(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), Histories::Near(&self.near), keep);
+        std::mem::swap(&mut self.near, spare);
+        self.sc.bounds.clear(); // replanned for the new list at the next step
+        self.x_near.clone_from(&self.x);
         self.builds.1 += 1;
     }
 
@@ -326,13 +331,15 @@ impl DemSystem {
         if self.p.friction {
             nl.carry_history(&self.near.list, &old_ids, &self.ids);
         }
-        self.near = NearList::select(&nl, &self.x, diameter, self.p.near_gap());
+        let (spare, keep) = &mut self.spare;
+        spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, keep);
+        std::mem::swap(&mut self.near, spare);
         self.outer = nl;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
-        self.sc = Scratch::default();
-        self.x_build = self.x.clone();
-        self.x_near = self.x.clone();
+        self.sc.bounds.clear(); // replanned for the new list at the next step
+        self.x_build.clone_from(&self.x);
+        self.x_near.clone_from(&self.x);
         self.rebuild_due = false;
         self.builds.0 += 1;
     }

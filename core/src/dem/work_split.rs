@@ -22,6 +22,13 @@ pub struct Scratch {
 impl Scratch {
     /// Plan `chunks` chunks (fewer for small systems) over the list.
     pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
+        let mut sc = Scratch::default();
+        sc.replan(nl, n, chunks);
+        sc
+    }
+
+    /// `plan` in this scratch's storage (reused: no fresh pages for the buffers).
+    pub fn replan(&mut self, nl: &NeighborList, n: usize, chunks: usize) {
         // The pair pass indexes without bounds checks: check the list once here (it may come
         // from a checkpoint) — rows ascending within 0..n, histories and flags one per entry.
         let total = nl.nbr.len();
@@ -57,10 +64,13 @@ impl Scratch {
             start.push(start[c] + e - a);
         }
         let len = start[nc];
-        let mut owner = Vec::with_capacity(total);
+        let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
+        acc.clear();
+        acc.resize(len, [0.0; 6]);
+        owner.clear();
         for i in 0..n {
             owner.extend(std::iter::repeat_n(i as u32, (nl.offsets[i + 1] - nl.offsets[i]) as usize));
         }
-        Scratch { bounds, start, acc: vec![[0.0; 6]; len], owner }
+        *self = Scratch { bounds, start, acc, owner };
     }
 }

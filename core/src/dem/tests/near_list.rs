@@ -1,12 +1,13 @@
 //! The near list (`near_list`): it holds every touching pair at every step of a fast,
-//! colliding run (checked by brute force over all pairs), and a pair pass over it gives the
-//! whole Verlet list's forces, flags and histories bit for bit.
+//! colliding run (checked by brute force over all pairs), a pair pass over it gives the whole
+//! Verlet list's forces, flags and histories bit for bit, and a refresh keeps every live history.
 
 use super::energy::random_gas;
 use super::{test_case, with_damping};
 use crate::dem::forces::{pair_pass, Kernels, Scratch};
 use crate::dem::DemSystem;
-use std::collections::HashSet;
+use crate::dem::near_list::{Histories, NearList};
+use std::collections::{HashMap, HashSet};
 
 /// Pairs (i < j) listed in the near list now.
 fn near_pairs(s: &DemSystem) -> HashSet<(u32, u32)> {
@@ -78,8 +79,14 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     for _ in 0..5 {
         s.step(); // live histories
     }
+    // The whole list with the near list's histories; every other entry not live.
     let mut outer = s.outer.clone();
-    s.near.write_back(&mut outer);
+    outer.touch.fill(0);
+    outer.shear.fill([1.0; 3]);
+    for (e, &k) in s.near.src.iter().enumerate() {
+        outer.shear[k as usize] = s.near.list.shear[e];
+        outer.touch[k as usize] = s.near.list.touch[e];
+    }
     let n = s.len();
     let run = |nl: &mut crate::dem::neighbors::NeighborList| {
         let mut sc = Scratch::plan(nl, n, 1);
@@ -104,4 +111,18 @@ fn near_list_pair_pass_equals_the_whole_lists() {
         assert_eq!(near.touch[e], outer.touch[k as usize]);
         assert!(near.shear[e].map(f64::to_bits) == outer.shear[k as usize].map(f64::to_bits), "history of entry {k}");
     }
+    // A refresh (with a gap of zero, so only touching or live entries stay) carries every live
+    // history of the old near list to the same pair, bit for bit.
+    let again = NearList::select(&s.outer, &s.x, d, 0.0, Histories::Near(&s.near));
+    assert!(again.src.len() < s.near.src.len(), "nothing left out");
+    let old: HashMap<u32, usize> = s.near.src.iter().enumerate().map(|(e, &k)| (k, e)).collect();
+    let mut live = 0;
+    for (e, &k) in again.src.iter().enumerate() {
+        let o = old[&k];
+        assert_eq!(again.list.nbr[e], s.near.list.nbr[o]);
+        assert_eq!(again.list.touch[e], s.near.list.touch[o]);
+        assert!(again.list.shear[e].map(f64::to_bits) == s.near.list.shear[o].map(f64::to_bits), "history of entry {k}");
+        live += again.list.touch[e] as usize;
+    }
+    assert_eq!(live, s.near.list.touch.iter().filter(|&&t| t == 1).count(), "a live history was dropped");
 }
