@@ -46,61 +46,61 @@ impl NearList {
     }
 
     /// `select` into this list's storage (its old contents are dropped; reusing the memory
-    /// spares the page faults of fresh allocations). `keep` is scratch, one flag per entry of
-    /// `outer`. Two parallel sweeps: flags and row counts, then the rows written in place.
-    pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories, keep: &mut Vec<u8>) {
+    /// spares the page faults of fresh allocations). `code` is scratch, one word per entry of
+    /// `outer`: 0 left out, 1 kept with `outer`'s history (none, under `Histories::Near`),
+    /// p + 2 kept with the old near entry p's. Two parallel sweeps: codes and row counts, then
+    /// the rows copied into place.
+    pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories, code: &mut Vec<u32>) {
         let n = outer.offsets.len().saturating_sub(1);
-        assert!(x.len() == n && outer.shear.len() == outer.nbr.len() && outer.touch.len() == outer.nbr.len(), "list shape");
+        let total_in = outer.nbr.len();
+        assert!(x.len() == n && outer.shear.len() == total_in && outer.touch.len() == total_in, "list shape");
+        assert!(outer.offsets.last().is_none_or(|&o| o as usize == total_in), "list offsets");
+        let empty = NearList::default();
         let old = match hist {
             Histories::Near(old) => {
                 assert!(old.list.offsets.len() == n + 1 && old.src.len() == old.list.nbr.len(), "near list of another list");
-                Some(old)
+                assert!(old.list.nbr.len() <= u32::MAX as usize - 2, "list too long");
+                old
             }
-            Histories::Outer => None,
+            Histories::Outer => &empty,
         };
+        let from_old = matches!(hist, Histories::Near(_));
         let reach2 = (diameter + gap) * (diameter + gap);
-        // Old near entry matching list entry k of row i (a cursor per row: the old row is a
-        // subsequence of the list row).
-        let cursor = |i: usize| old.map_or(0, |o| o.list.offsets[i] as usize);
-        let matches = |p: usize, i: usize, k: usize| old.is_some_and(|o| p < o.list.offsets[i + 1] as usize && o.src[p] as usize == k);
-        keep.clear();
-        keep.resize(outer.nbr.len(), 0);
+        code.clear();
+        code.resize(total_in, 0);
         let mut counts = vec![0u32; n];
-        let rows = |b: usize| b * BLOCK..((b + 1) * BLOCK).min(n);
+        let blocks: Vec<_> = (0..n.div_ceil(BLOCK)).map(|b| b * BLOCK..((b + 1) * BLOCK).min(n)).collect();
         let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
-        let blocks: Vec<_> = (0..n.div_ceil(BLOCK)).map(rows).collect();
-        // Sweep 1: flags and counts.
-        let mut kb = Vec::with_capacity(blocks.len());
-        let (mut krest, mut crest) = (&mut keep[..], &mut counts[..]);
+        // Sweep 1: codes and counts, block by block.
+        let mut work = Vec::with_capacity(blocks.len());
+        let (mut crest, mut nrest) = (&mut code[..], &mut counts[..]);
         for r in &blocks {
-            let (k0, k1) = std::mem::take(&mut krest).split_at_mut(entries(r).len());
-            let (c0, c1) = std::mem::take(&mut crest).split_at_mut(r.len());
-            (krest, crest) = (k1, c1);
-            kb.push((r.clone(), k0, c0));
+            let (c0, c1) = std::mem::take(&mut crest).split_at_mut(entries(r).len());
+            let (n0, n1) = std::mem::take(&mut nrest).split_at_mut(r.len());
+            (crest, nrest) = (c1, n1);
+            work.push((r.clone(), c0, n0));
         }
-        kb.into_par_iter().for_each(|(r, kf, cnt)| {
+        work.into_par_iter().for_each(|(r, codes, cnt)| {
             let base = outer.offsets[r.start] as usize;
             for i in r.clone() {
-                let (xi, mut p) = (x[i], cursor(i));
+                let xi = x[i];
+                // Cursor over the old near row i, a subsequence of the list row.
+                let (mut p, p_end) = if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
                 for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
-                    let live = match old {
-                        None => outer.touch[k] != 0,
-                        Some(o) if matches(p, i, k) => {
-                            p += 1;
-                            o.list.touch[p - 1] != 0
-                        }
-                        Some(_) => false,
-                    };
+                    let matched = p < p_end && old.src[p] as usize == k;
+                    let live = if from_old { matched && old.list.touch[p] != 0 } else { outer.touch[k] != 0 };
                     let xj = x[outer.nbr[k] as usize];
                     let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                     let take = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach2 || live;
-                    kf[k - base] = take as u8;
+                    let c = if matched { p as u32 + 2 } else { 1 };
+                    codes[k - base] = if take { c } else { 0 };
                     cnt[i - r.start] += take as u32;
+                    p += matched as usize;
                 }
-                assert!(old.is_none_or(|o| p == o.list.offsets[i + 1] as usize), "old near row {i} is not a subsequence of the list row");
+                assert!(p == p_end, "old near row {i} is not a subsequence of the list row");
             }
         });
-        // Offsets, then sweep 2: each block's rows written into its part of the storage.
+        // Offsets, then sweep 2: each block's kept entries copied into its part of the storage.
         let l = &mut self.list;
         l.offsets.clear();
         l.offsets.push(0);
@@ -122,27 +122,23 @@ impl NearList {
             let (h0, h1) = std::mem::take(&mut h).split_at_mut(len);
             let (t0, t1) = std::mem::take(&mut t).split_at_mut(len);
             (s, j, h, t) = (s1, j1, h1, t1);
-            work.push((r, s0, j0, h0, t0));
+            work.push((entries(&r), s0, j0, h0, t0));
         }
-        let keep = &keep[..];
-        work.into_par_iter().for_each(|(r, src, nbr, shear, touch)| {
+        let code = &code[..];
+        work.into_par_iter().for_each(|(ks, src, nbr, shear, touch)| {
             let mut e = 0;
-            for i in r {
-                let mut p = cursor(i);
-                for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
-                    let (sh, to) = match old {
-                        None => (outer.shear[k], outer.touch[k]),
-                        Some(o) if matches(p, i, k) => {
-                            p += 1;
-                            (o.list.shear[p - 1], o.list.touch[p - 1])
-                        }
-                        Some(_) => ([0.0; 3], 0),
-                    };
-                    if keep[k] != 0 {
-                        (src[e], nbr[e], shear[e], touch[e]) = (k as u32, outer.nbr[k], sh, to);
-                        e += 1;
-                    }
+            for k in ks {
+                let c = code[k] as usize;
+                if c == 0 {
+                    continue;
                 }
+                let (sh, to) = match (c, from_old) {
+                    (1, false) => (outer.shear[k], outer.touch[k]),
+                    (1, true) => ([0.0; 3], 0),
+                    _ => (old.list.shear[c - 2], old.list.touch[c - 2]),
+                };
+                (src[e], nbr[e], shear[e], touch[e]) = (k as u32, outer.nbr[k], sh, to);
+                e += 1;
             }
         });
     }

@@ -43,9 +43,9 @@ pub struct DemSystem {
     /// Verlet-list builds and near-list refreshes so far (diagnostics).
     builds: (u64, u64),
     last: (f64, f64),
-    /// Storage reused by near-list refreshes (the previous list's, and a flag per entry).
+    /// Storage reused by near-list refreshes (the previous list's, and a code per entry).
     #[serde(skip)]
-    spare: (NearList, Vec<u8>),
+    spare: (NearList, Vec<u32>),
     #[serde(skip)]
     sc_threads: usize,
     /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
@@ -256,8 +256,8 @@ impl DemSystem {
             self.rebuild_due = true;
             return;
         }
-        let (spare, keep) = &mut self.spare;
-        spare.select_into(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), Histories::Near(&self.near), keep);
+        let (spare, code) = &mut self.spare;
+        spare.select_into(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), Histories::Near(&self.near), code);
         std::mem::swap(&mut self.near, spare);
         self.sc.bounds.clear(); // replanned for the new list at the next step
         self.x_near.clone_from(&self.x);
@@ -331,8 +331,8 @@ impl DemSystem {
         if self.p.friction {
             nl.carry_history(&self.near.list, &old_ids, &self.ids);
         }
-        let (spare, keep) = &mut self.spare;
-        spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, keep);
+        let (spare, code) = &mut self.spare;
+        spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, code);
         std::mem::swap(&mut self.near, spare);
         self.outer = nl;
         let had_walls = !self.x_build.is_empty();

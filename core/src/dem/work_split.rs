@@ -3,6 +3,7 @@
 
 use super::forces::Acc;
 use super::neighbors::NeighborList;
+use rayon::prelude::*;
 
 /// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
 /// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
@@ -34,12 +35,8 @@ impl Scratch {
         let total = nl.nbr.len();
         assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
         assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
-        assert!(nl.nbr.iter().all(|&j| (j as usize) < n), "neighbour list index");
         assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
-        let mut bounds = Vec::with_capacity(nc);
-        let mut start = Vec::with_capacity(nc + 1);
-        start.push(0);
         // Chunk c ends where the work (list entries plus one per particle) reaches (c+1)/nc of
         // the total, so that the chunks take about the same time.
         let work = |i: usize| nl.offsets[i] as usize + i;
@@ -51,26 +48,40 @@ impl Scratch {
             }
             lo
         };
+        let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
+        owner.resize(total, 0);
+        // Per chunk, in parallel: check every partner (i < j < n), find the halo end e, and
+        // write each entry's row.
+        let mut parts = Vec::with_capacity(nc);
+        let mut rest = &mut owner[..];
         for c in 0..nc {
             let (a, b) = (cut(c), cut(c + 1));
-            let mut e = b;
-            for i in a..b {
-                for &j in &nl.nbr[nl.offsets[i] as usize..nl.offsets[i + 1] as usize] {
-                    assert!(j as usize > i, "half list holds j > i only");
-                    e = e.max(j as usize + 1);
+            let (o, r) = std::mem::take(&mut rest).split_at_mut((nl.offsets[b] - nl.offsets[a]) as usize);
+            rest = r;
+            parts.push((a, b, o));
+        }
+        let bounds: Vec<[usize; 3]> = parts
+            .into_par_iter()
+            .map(|(a, b, own)| {
+                let (mut e, base) = (b, nl.offsets[a] as usize);
+                for i in a..b {
+                    let (k0, k1) = (nl.offsets[i] as usize, nl.offsets[i + 1] as usize);
+                    for (k, &j) in (k0..k1).zip(&nl.nbr[k0..k1]) {
+                        assert!(j as usize > i && (j as usize) < n, "half list holds i < j < n only");
+                        e = e.max(j as usize + 1);
+                        own[k - base] = i as u32;
+                    }
                 }
-            }
-            bounds.push([a, b, e]);
+                [a, b, e]
+            })
+            .collect();
+        let mut start = Vec::with_capacity(nc + 1);
+        start.push(0);
+        for (c, &[a, _, e]) in bounds.iter().enumerate() {
             start.push(start[c] + e - a);
         }
-        let len = start[nc];
-        let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
         acc.clear();
-        acc.resize(len, [0.0; 6]);
-        owner.clear();
-        for i in 0..n {
-            owner.extend(std::iter::repeat_n(i as u32, (nl.offsets[i + 1] - nl.offsets[i]) as usize));
-        }
+        acc.resize(start[nc], [0.0; 6]);
         *self = Scratch { bounds, start, acc, owner };
     }
 }
