@@ -134,11 +134,15 @@ pub fn run() {
             let secs = t0.elapsed().as_secs_f64();
             let rate = sys.len() as f64 * timed as f64 / secs;
             let (builds, refreshes) = sys.list_builds();
+            let (outer, near) = sys.list_sizes();
+            let per = |e: usize| e as f64 / sys.len() as f64;
             eprintln!(
-                "dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes",
+                "dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes, {:.2} / {:.2} entries per particle",
                 secs,
                 sys.kinetic_energy(),
-                sys.max_overlap_fraction()
+                sys.max_overlap_fraction(),
+                per(outer),
+                per(near)
             );
             println!(
                 "{{\"bench\":\"{}\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",

@@ -130,6 +130,10 @@ impl DemSystem {
     pub fn list_builds(&self) -> (u64, u64) {
         self.builds
     }
+    /// Entries of the Verlet list and of the near list now.
+    pub fn list_sizes(&self) -> (usize, usize) {
+        (self.outer.nbr.len(), self.near.list.nbr.len())
+    }
     pub fn is_frozen(&self) -> bool {
         self.frozen
     }
