@@ -53,7 +53,7 @@ impl NearList {
     pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories, code: &mut Vec<u32>) {
         let n = outer.offsets.len().saturating_sub(1);
         let total_in = outer.nbr.len();
-        assert!(x.len() == n && outer.shear.len() == total_in && outer.touch.len() == total_in, "list shape");
+        assert!(x.len() == n, "one position per list row");
         assert!(outer.offsets.last().is_none_or(|&o| o as usize == total_in), "list offsets");
         let empty = NearList::default();
         let old = match hist {
@@ -62,7 +62,10 @@ impl NearList {
                 assert!(old.list.nbr.len() <= u32::MAX as usize - 2, "list too long");
                 old
             }
-            Histories::Outer => &empty,
+            Histories::Outer => {
+                assert!(outer.shear.len() == total_in && outer.touch.len() == total_in, "list histories");
+                &empty
+            }
         };
         let from_old = matches!(hist, Histories::Near(_));
         let reach2 = (diameter + gap) * (diameter + gap);

@@ -29,8 +29,8 @@ pub struct DemSystem {
     x_near: Vec<V3>,
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
-    /// The Verlet list (skin `p.skin`) and the near list drawn from it, which holds the live
-    /// contact histories.
+    /// The Verlet list (cutoff `p.cutoff`; its history arrays are emptied once the near list is
+    /// drawn) and the near list drawn from it, which holds the live contact histories.
     pub(super) outer: NeighborList,
     pub(super) near: NearList,
     pub(super) walls: WallList,
@@ -338,6 +338,7 @@ impl DemSystem {
         let (spare, code) = &mut self.spare;
         spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, code);
         std::mem::swap(&mut self.near, spare);
+        (nl.shear, nl.touch) = (Vec::new(), Vec::new());
         self.outer = nl;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));

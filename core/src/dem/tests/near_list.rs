@@ -81,8 +81,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     }
     // The whole list with the near list's histories; every other entry not live.
     let mut outer = s.outer.clone();
-    outer.touch.fill(0);
-    outer.shear.fill([1.0; 3]);
+    (outer.touch, outer.shear) = (vec![0; outer.nbr.len()], vec![[1.0; 3]; outer.nbr.len()]);
     for (e, &k) in s.near.src.iter().enumerate() {
         outer.shear[k as usize] = s.near.list.shear[e];
         outer.touch[k as usize] = s.near.list.touch[e];
