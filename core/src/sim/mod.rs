@@ -17,6 +17,11 @@ use crate::grid::CylGrid;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+/// First bytes of a checkpoint, then the format number (u32, little-endian), then the state.
+const CHECKPOINT_MAGIC: &[u8; 8] = b"FLUIDBED";
+/// Bumped whenever the serialised state changes shape (format 2: the DEM's near list).
+const CHECKPOINT_FORMAT: u32 = 2;
+
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimError {
     /// The case cannot be built (bed generation failed, ...).
@@ -165,13 +170,32 @@ impl Simulation {
         Ok(())
     }
 
-    /// The complete state; `restore` continues bit-identically.
+    /// The complete state behind a format header; `restore` continues bit-identically.
     pub fn checkpoint(&self) -> Vec<u8> {
-        bincode::serialize(&self.st).expect("state serialises")
+        let mut out = CHECKPOINT_MAGIC.to_vec();
+        out.extend_from_slice(&CHECKPOINT_FORMAT.to_le_bytes());
+        bincode::serialize_into(&mut out, &self.st).expect("state serialises");
+        out
     }
 
     pub fn restore(bytes: &[u8]) -> Result<Simulation, SimError> {
-        let st: State = bincode::deserialize(bytes).map_err(|e| SimError::Checkpoint(e.to_string()))?;
+        let body = match bytes.strip_prefix(CHECKPOINT_MAGIC) {
+            Some(rest) if rest.len() >= 4 => {
+                let format = u32::from_le_bytes(rest[..4].try_into().expect("four bytes"));
+                if format != CHECKPOINT_FORMAT {
+                    return Err(SimError::Checkpoint(format!(
+                        "written in checkpoint format {format}, this build reads format {CHECKPOINT_FORMAT}; rerun the case or resume it with the fluidbed version that wrote it"
+                    )));
+                }
+                &rest[4..]
+            }
+            _ => {
+                return Err(SimError::Checkpoint(
+                    "not a fluidbed checkpoint, or one from a version before checkpoint formats (November 2026); rerun the case".into(),
+                ))
+            }
+        };
+        let st: State = bincode::deserialize(body).map_err(|e| SimError::Checkpoint(e.to_string()))?;
         let grid = fluid_grid(&st.case);
         let mut sim = Simulation::assemble(st, grid);
         sim.refresh_voidage_field();
