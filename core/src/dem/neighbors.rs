@@ -1,8 +1,8 @@
 //! O(N) neighbour search: linked cells give the cell order (particles are re-sorted by cell
 //! at every rebuild for memory locality) and a half Verlet list (each pair once, j > i) in CSR
-//! form, each row nearest first (touching pairs lead), with room for the tangential contact
-//! history parallel to it (the near list holds the live copy between builds; `near_list`).
-//! History survives rebuilds by particle-id pair. Everything here is deterministic and independent of the thread count.
+//! form, each row nearest first (touching pairs lead). At a build the tangential contact
+//! histories are carried into it by particle-id pair, then handed to the near list (`near_list`),
+//! which holds them between builds. Everything here is deterministic and independent of the thread count.
 
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};

@@ -69,7 +69,6 @@ pub fn split_two(c: f64, h: f64, axis: &Axis) -> [(usize, f64); 2] {
     [(first, share), ((first + 1).min(axis.n - 1), 1.0 - share)]
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::super::sphere_box::cap1;
