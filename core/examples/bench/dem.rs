@@ -137,8 +137,9 @@ pub fn run() {
             let (outer, near) = sys.list_sizes();
             let per = |e: usize| e as f64 / sys.len() as f64;
             eprintln!(
-                "dem: {threads} thread(s), {:.3} s, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes, {:.2} / {:.2} entries per particle",
+                "dem: {threads} thread(s), {:.3} s, state {:016x}, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes, {:.2} / {:.2} entries per particle",
                 secs,
+                state_digest(&sys),
                 sys.kinetic_energy(),
                 sys.max_overlap_fraction(),
                 per(outer),
@@ -154,4 +155,16 @@ pub fn run() {
             );
         });
     }
+}
+
+/// FNV-1a over the bits of every position, velocity and spin: equal digests mean a code change
+/// left the trajectory bit for bit the same (for one thread count).
+fn state_digest(sys: &DemSystem) -> u64 {
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    for arr in [sys.positions(), sys.velocities(), sys.angular_velocities()] {
+        for c in arr.iter().flatten() {
+            h = (h ^ c.to_bits()).wrapping_mul(0x0000_0100_0000_01b3);
+        }
+    }
+    h
 }

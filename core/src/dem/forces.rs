@@ -5,7 +5,8 @@
 //! 2. the particle pass (`particle_pass`): per block, sum the chunk buffers in chunk order, add
 //!    walls (only for the wall list), gravity and the external force, and advance by AB3.
 //!
-//! This file holds the shared types and pass 1.
+//! This file holds the shared types and pass 1. `team_step` runs both passes as one broadcast
+//! (the multistep steps); `pair_pass` alone serves the start-up and the fallback.
 
 use super::pair_batch::{Batch, CAP};
 #[cfg(target_arch = "x86_64")]
@@ -108,22 +109,22 @@ pub fn pair_pass<const FR: bool>(
 }
 
 /// Read-only inputs of one chunk of the pair pass.
-struct ChunkArgs<'a> {
-    law: &'a ContactLaw,
-    r: f64,
-    h: f64,
-    d2: f64,
-    a: usize,
-    b: usize,
-    offsets: &'a [u32],
-    nbr: &'a [u32],
-    owner: &'a [u32],
-    x: &'a [V3],
-    v: &'a [V3],
-    w: &'a [V3],
+pub(super) struct ChunkArgs<'a> {
+    pub law: &'a ContactLaw,
+    pub r: f64,
+    pub h: f64,
+    pub d2: f64,
+    pub a: usize,
+    pub b: usize,
+    pub offsets: &'a [u32],
+    pub nbr: &'a [u32],
+    pub owner: &'a [u32],
+    pub x: &'a [V3],
+    pub v: &'a [V3],
+    pub w: &'a [V3],
 }
 
-fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f")

@@ -23,6 +23,7 @@ pub mod pair_batch;
 pub mod particle_pass;
 pub mod pair_simd;
 pub mod system;
+pub mod team_step;
 pub mod walls;
 pub mod work_split;
 

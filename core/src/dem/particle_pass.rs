@@ -4,7 +4,8 @@
 //! the thread count.
 
 use super::contact::V3;
-use super::forces::{Acc, Past, Scratch, Stats};
+use super::forces::{Acc, Past, Stats};
+use super::work_split::Sums;
 use super::walls::{wall_forces, WallList};
 use super::DemParams;
 use rayon::prelude::*;
@@ -18,7 +19,7 @@ pub const BLOCK: usize = 256;
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn block_accel<const FR: bool>(
-    p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: &Scratch, widx: &[u32],
+    p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: Sums, widx: &[u32],
     whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
 ) {
     let hi = lo + out.len();
@@ -70,7 +71,7 @@ fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> 
 /// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
 #[allow(clippy::too_many_arguments)]
 pub fn accel_pass<const FR: bool>(
-    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], walls: &mut WallList, ext: &[V3], sc: &Scratch, out: &mut [Acc],
+    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], walls: &mut WallList, ext: &[V3], sc: Sums, out: &mut [Acc],
 ) -> Stats {
     let wb = wall_blocks(walls, x.len());
     out.par_chunks_mut(BLOCK)
@@ -97,20 +98,20 @@ pub struct Motion<'a> {
 }
 
 /// One block's share of `Motion`; `older` slots are overwritten with the current derivatives.
-struct BlockMotion<'a> {
-    lo: usize,
-    x: &'a mut [V3],
-    v: &'a mut [V3],
-    w: &'a mut [V3],
-    newer: [&'a [V3]; 3],
-    older: [&'a mut [V3]; 3],
-    widx: &'a [u32],
-    whist: &'a mut [[V3; 3]],
+pub(super) struct BlockMotion<'a> {
+    pub lo: usize,
+    pub x: &'a mut [V3],
+    pub v: &'a mut [V3],
+    pub w: &'a mut [V3],
+    pub newer: [&'a [V3]; 3],
+    pub older: [&'a mut [V3]; 3],
+    pub widx: &'a [u32],
+    pub whist: &'a mut [[V3; 3]],
 }
 
 /// Pass 2, fused: accelerations and the multistep update (weights `hb` = h·b; slot `ring` of
 /// `past` holds the newer values, the current derivative overwrites the other) in one sweep.
-pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: Motion, ext: &[V3], sc: &Scratch) -> Stats {
+pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: Motion, ext: &[V3], sc: Sums) -> Stats {
     let n = m.x.len();
     let older = 1 - ring;
     let mut wb = wall_blocks(m.walls, n).into_iter();
@@ -140,7 +141,7 @@ pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: 
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+pub(super) fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
@@ -157,13 +158,13 @@ fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockM
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn update_block_avx512<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+unsafe fn update_block_avx512<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
     update_block::<FR>(p, hb, bm, xb, ext, sc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
     update_block::<FR>(p, hb, bm, xb, ext, sc)
 }
 
@@ -177,7 +178,7 @@ fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f
 }
 
 #[inline(always)]
-fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_ref: &[V3], ext: &[V3], sc: &Scratch) -> Stats {
+fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_ref: &[V3], ext: &[V3], sc: Sums) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
     let len = x.len();
     let mut st = Stats::ZERO;

@@ -1,11 +1,12 @@
 //! `DemSystem`: the particle state (structure of arrays) and the step loop.
 //! A step is: pair pass over the near list → fused particle pass (walls, gravity, external
-//! force, AB update) → near-list refresh when any particle moved more than about half the near
+//! force, AB update; the two passes run as one team of threads, `team_step`) → near-list refresh when any particle moved more than about half the near
 //! gap, with a Verlet-list rebuild and re-sort first if the list could miss a near pair.
 
 use super::contact::V3;
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
 use super::particle_pass::{accel_pass, update_pass, Motion};
+use super::team_step::{team_step, StepState, TeamLock};
 use super::integrator::weights;
 use super::near_list::{Histories, NearList};
 use super::neighbors::{build_list, cell_order, NeighborList};
@@ -218,29 +219,48 @@ impl DemSystem {
             self.sc.replan(&self.near.list, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
-        let st2 = if self.levels == 0 {
-            self.heun::<FR>()
+        let refresh_disp2 = self.p.near_move() * self.p.near_move();
+        let st = if self.levels == 0 {
+            let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+            st1.max(self.heun::<FR>())
         } else {
             let h = self.p.dt;
             let b = weights(self.levels);
             let hb = [h * b[0], h * b[1], h * b[2]];
-            let m = Motion {
-                x: &mut self.x,
-                v: &mut self.v,
-                w: &mut self.w,
-                past: &mut self.past,
-                x_ref: &self.x_near,
-                walls: &mut self.walls,
+            let st = match TeamLock::try_take() {
+                Some(_lock) => {
+                    let s = StepState {
+                        x: &mut self.x,
+                        v: &mut self.v,
+                        w: &mut self.w,
+                        past: &mut self.past,
+                        walls: &mut self.walls,
+                        nl: &mut self.near.list,
+                        sc: &mut self.sc,
+                    };
+                    team_step::<FR>(&self.p, hb, self.ring as usize, s, &self.x_near, &self.ext)
+                }
+                // Another system steps with a team now (nested or concurrent use of the pool):
+                // two parallel loops instead, which cannot wait on each other.
+                None => {
+                    let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+                    let m = Motion {
+                        x: &mut self.x,
+                        v: &mut self.v,
+                        w: &mut self.w,
+                        past: &mut self.past,
+                        x_ref: &self.x_near,
+                        walls: &mut self.walls,
+                    };
+                    st1.max(update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, self.sc.sums()))
+                }
             };
-            let st = update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, &self.sc);
             self.ring = 1 - self.ring;
             self.levels = (self.levels + 1).min(3);
             st
         };
-        let st = st1.max(st2);
         self.last = (st.overlap, st.coulomb_excess);
-        if st.disp2 > self.p.near_move() * self.p.near_move() {
+        if st.disp2 > refresh_disp2 {
             self.refresh();
         }
         if self.rebuild_due {
@@ -274,7 +294,7 @@ impl DemSystem {
         let n = self.x.len();
         let h = self.p.dt;
         let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
-        let st = accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d0);
+        let st = accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
         let nl = &self.near.list;
         let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
@@ -286,7 +306,7 @@ impl DemSystem {
         }
         pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
-        accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, &self.sc, &mut d1);
+        accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
         (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
         let mut disp2: f64 = 0.0;
         let newer = 1 - self.ring as usize;

@@ -20,7 +20,19 @@ pub struct Scratch {
     pub owner: Vec<u32>,
 }
 
+/// The chunk buffers as the particle pass reads them.
+#[derive(Clone, Copy)]
+pub struct Sums<'a> {
+    pub bounds: &'a [[usize; 3]],
+    pub start: &'a [usize],
+    pub acc: &'a [Acc],
+}
+
 impl Scratch {
+    pub fn sums(&self) -> Sums<'_> {
+        Sums { bounds: &self.bounds, start: &self.start, acc: &self.acc }
+    }
+
     /// Plan `chunks` chunks (fewer for small systems) over the list.
     pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
         let mut sc = Scratch::default();

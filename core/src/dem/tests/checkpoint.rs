@@ -5,7 +5,7 @@ use super::energy::random_gas;
 use super::{test_case, with_damping};
 use crate::dem::DemSystem;
 
-fn busy_system() -> DemSystem {
+pub(super) fn busy_system() -> DemSystem {
     // Frictional, damped, gravity, lid: every code path, with list rebuilds and re-sorts; more
     // than 512 particles so the pair pass really splits into chunks across the threads.
     let case = with_damping(test_case(0.012, 0.03, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
@@ -32,7 +32,7 @@ fn run_in_pool(threads: usize, steps: usize) -> DemSystem {
     run_counting(threads, steps).0
 }
 
-fn same_state(a: &DemSystem, b: &DemSystem) -> bool {
+pub(super) fn same_state(a: &DemSystem, b: &DemSystem) -> bool {
     a.ids() == b.ids()
         && a.positions() == b.positions()
         && a.velocities() == b.velocities()

@@ -9,6 +9,7 @@ mod near_list;
 mod poured_bed;
 mod restitution;
 mod sliding;
+mod team_step;
 mod wall_loads;
 
 use crate::case::{Bed, Case, Column, Damping, ExplicitBed, Particles};

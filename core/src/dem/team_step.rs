@@ -1,0 +1,192 @@
+//! One multistep DEM step as a single rayon broadcast: every thread of the pool takes a fixed
+//! share of the pair-pass chunks, waits at a spin barrier, then takes a fixed share of the
+//! particle-pass blocks. As two parallel loops (`forces::pair_pass`, then
+//! `particle_pass::update_pass`) the pool's threads fall asleep between the passes and must be
+//! woken (tens of µs a pass on a VM); here they spin instead. The work is that of the two
+//! passes (the same chunks, buffers and blocks), so every bit of the result is the same.
+
+use super::contact::V3;
+use super::forces::{chunk_pairs_dispatch, ChunkArgs, Past, Scratch, Stats};
+use super::neighbors::NeighborList;
+use super::particle_pass::{update_block_dispatch, BlockMotion, BLOCK};
+use super::walls::WallList;
+use super::work_split::Sums;
+use super::DemParams;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+/// A barrier for the threads of one broadcast that spins (then yields) instead of sleeping.
+struct SpinBarrier {
+    arrived: AtomicUsize,
+    generation: AtomicUsize,
+    n: usize,
+}
+
+impl SpinBarrier {
+    fn new(n: usize) -> Self {
+        SpinBarrier { arrived: AtomicUsize::new(0), generation: AtomicUsize::new(0), n }
+    }
+
+    /// Returns once all `n` threads have called it; writes before it are seen after it.
+    fn wait(&self) {
+        let g = self.generation.load(Ordering::Acquire);
+        if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.n {
+            self.arrived.store(0, Ordering::Relaxed);
+            self.generation.store(g.wrapping_add(1), Ordering::Release);
+            return;
+        }
+        let mut spins = 0u32;
+        while self.generation.load(Ordering::Acquire) == g {
+            if spins < 1 << 12 {
+                std::hint::spin_loop();
+                spins += 1;
+            } else {
+                std::thread::yield_now();
+            }
+        }
+    }
+}
+
+/// A slice the team reads whole in one phase and writes in disjoint pieces in another.
+#[derive(Clone, Copy)]
+struct Raw<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: `Raw` hands out references only under the phase rules of `team_steps`.
+unsafe impl<T: Send + Sync> Send for Raw<T> {}
+unsafe impl<T: Send + Sync> Sync for Raw<T> {}
+
+impl<T> Raw<T> {
+    fn new(s: &mut [T]) -> Self {
+        Raw { ptr: s.as_mut_ptr(), len: s.len() }
+    }
+    /// # Safety
+    /// No mutable reference into the slice is live while the returned one is.
+    unsafe fn all<'a>(self) -> &'a [T] {
+        std::slice::from_raw_parts(self.ptr, self.len)
+    }
+    /// # Safety
+    /// No other reference into lo..hi is live while the returned one is.
+    unsafe fn part<'a>(self, lo: usize, hi: usize) -> &'a mut [T] {
+        assert!(lo <= hi && hi <= self.len, "piece {lo}..{hi} of {}", self.len);
+        std::slice::from_raw_parts_mut(self.ptr.add(lo), hi - lo)
+    }
+}
+
+/// At most one team at a time in the process: a team's threads spin at its barriers, so two
+/// teams sharing a pool could each wait for a thread the other holds. Whoever does not get the
+/// lock steps with plain parallel loops.
+pub struct TeamLock(());
+
+static TEAM_BUSY: AtomicBool = AtomicBool::new(false);
+
+impl TeamLock {
+    pub fn try_take() -> Option<TeamLock> {
+        TEAM_BUSY.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok().map(|_| TeamLock(()))
+    }
+}
+
+impl Drop for TeamLock {
+    fn drop(&mut self) {
+        TEAM_BUSY.store(false, Ordering::Release);
+    }
+}
+
+/// The state the steps change.
+pub struct StepState<'a> {
+    pub x: &'a mut [V3],
+    pub v: &'a mut [V3],
+    pub w: &'a mut [V3],
+    pub past: &'a mut Past,
+    pub walls: &'a mut WallList,
+    pub nl: &'a mut NeighborList,
+    pub sc: &'a mut Scratch,
+}
+
+/// The pair pass and the fused particle pass of one step: weights `hb` (= h·b), newer past
+/// slot `ring`, displacements measured from `x_ref`.
+pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: StepState, x_ref: &[V3], ext: &[V3]) -> Stats {
+    let StepState { x, v, w, past, walls, nl, sc } = s;
+    let n = x.len();
+    assert!(v.len() == n && w.len() == n && x_ref.len() == n && ext.len() == n);
+    assert!(past.v.iter().chain(&past.a).chain(&past.alpha).all(|s| s.len() == n), "past derivatives");
+    let (offsets, nbr) = (&nl.offsets[..], &nl.nbr[..]);
+    let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
+    assert!(start.len() > bounds.len() && bounds.iter().all(|&[a, b, e]| a <= b && b <= e && e <= n));
+    let (nc, nb) = (bounds.len(), n.div_ceil(BLOCK));
+    // Each block's wall-list entries (the list is sorted by particle).
+    let wall_at = |b: usize| walls.idx.partition_point(|&i| (i as usize) < (b * BLOCK).min(n));
+    let wall_cut: Vec<usize> = (0..=nb).map(wall_at).collect();
+    let widx = &walls.idx[..];
+    let raw = Shared {
+        x: Raw::new(x),
+        v: Raw::new(v),
+        w: Raw::new(w),
+        past: [&mut past.v, &mut past.a, &mut past.alpha].map(|[s0, s1]| [Raw::new(s0), Raw::new(s1)]),
+        whist: Raw::new(&mut walls.hist),
+        shear: Raw::new(&mut nl.shear),
+        touch: Raw::new(&mut nl.touch),
+        acc: Raw::new(&mut sc.acc),
+    };
+    let team = rayon::current_num_threads();
+    let phases = SpinBarrier::new(team);
+    let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
+    let per_thread = rayon::broadcast(|ctx| {
+        let (t, nt) = (ctx.index(), ctx.num_threads());
+        assert!(nt == team, "broadcast on the pool that was counted");
+        let mut st = Stats::ZERO;
+        // A panic before the barrier is raised after it (the others would spin there for ever).
+        let pairs = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            // SAFETY: until the barrier x, v, w are only read; chunk c's histories, flags and
+            // buffer (disjoint from the other chunks') are written by its thread alone.
+            let (x, v, w) = unsafe { (raw.x.all(), raw.v.all(), raw.w.all()) };
+            for c in (0..nc).filter(|&c| c * nt / nc == t) {
+                let [a, b, e] = bounds[c];
+                let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
+                let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
+                let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
+                let args = ChunkArgs { law: &p.pair, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
+                st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
+            }
+        }));
+        phases.wait();
+        if let Err(e) = pairs {
+            std::panic::resume_unwind(e);
+        }
+        // SAFETY: after the barrier the buffers are only read, and block b's particles and
+        // wall entries (disjoint from the other blocks') are touched by its thread alone.
+        let sums = Sums { bounds, start, acc: unsafe { raw.acc.all() } };
+        let older = 1 - ring;
+        for b in t * nb / nt..(t + 1) * nb / nt {
+            let (lo, hi, w0, w1) = (b * BLOCK, ((b + 1) * BLOCK).min(n), wall_cut[b], wall_cut[b + 1]);
+            let slot = |q: usize, s: usize| unsafe { raw.past[q][s].part(lo, hi) };
+            let bm = BlockMotion {
+                lo,
+                x: unsafe { raw.x.part(lo, hi) },
+                v: unsafe { raw.v.part(lo, hi) },
+                w: unsafe { raw.w.part(lo, hi) },
+                newer: [0, 1, 2].map(|q| &*slot(q, ring)),
+                older: [0, 1, 2].map(|q| slot(q, older)),
+                widx: &widx[w0..w1],
+                whist: unsafe { raw.whist.part(w0, w1) },
+            };
+            st = st.max(update_block_dispatch::<FR>(p, hb, bm, x_ref, ext, sums));
+        }
+        st
+    });
+    per_thread.into_iter().fold(Stats::ZERO, Stats::max)
+}
+
+/// Raw views of everything the threads write.
+#[derive(Clone, Copy)]
+struct Shared {
+    x: Raw<V3>,
+    v: Raw<V3>,
+    w: Raw<V3>,
+    past: [[Raw<V3>; 2]; 3],
+    whist: Raw<[V3; 3]>,
+    shear: Raw<V3>,
+    touch: Raw<u8>,
+    acc: Raw<super::forces::Acc>,
+}
