@@ -1,7 +1,8 @@
 //! `DemSystem`: the particle state (structure of arrays) and the step loop.
 //! A step is: pair pass over the near list → fused particle pass (walls, gravity, external
-//! force, AB update; the two passes run as one team of threads, `team_step`) → near-list refresh when any particle moved more than about half the near
-//! gap, with a Verlet-list rebuild and re-sort first if the list could miss a near pair.
+//! force, AB update; both passes run by one team of threads, `team_step`) → near-list refresh
+//! when any particle moved more than about half the near gap, with a Verlet-list rebuild and
+//! re-sort first if the list could miss a near pair.
 
 use super::contact::V3;
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
