@@ -44,6 +44,9 @@ pub struct DemSystem {
     rebuild_due: bool,
     /// Verlet-list builds and near-list refreshes so far (diagnostics).
     builds: (u64, u64),
+    /// Steps run by a team of threads (`team_step`) since creation or restore (diagnostics).
+    #[serde(skip)]
+    team_steps: u64,
     last: (f64, f64),
     /// Storage reused by near-list refreshes (the previous list's, and a code per entry).
     #[serde(skip)]
@@ -84,6 +87,7 @@ impl DemSystem {
             frozen: false,
             rebuild_due: false,
             builds: (0, 0),
+            team_steps: 0,
             last: (0.0, f64::NEG_INFINITY),
             spare: Default::default(),
             sc_threads: 0,
@@ -131,6 +135,10 @@ impl DemSystem {
     /// Verlet-list builds and near-list refreshes (without a build) so far.
     pub fn list_builds(&self) -> (u64, u64) {
         self.builds
+    }
+    /// Steps run by a team of threads rather than two parallel loops (see `team_step`).
+    pub fn team_steps(&self) -> u64 {
+        self.team_steps
     }
     /// Entries of the Verlet list and of the near list now.
     pub fn list_sizes(&self) -> (usize, usize) {
@@ -239,6 +247,7 @@ impl DemSystem {
                         nl: &mut self.near.list,
                         sc: &mut self.sc,
                     };
+                    self.team_steps += 1;
                     team_step::<FR>(&self.p, hb, self.ring as usize, s, &self.x_near, &self.ext)
                 }
                 // Another system steps with a team now (nested or concurrent use of the pool):
