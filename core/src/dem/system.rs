@@ -211,18 +211,26 @@ impl DemSystem {
 
     /// One DEM step of the case's time step (uses the current rayon pool).
     pub fn step(&mut self) {
+        let team = TeamLock::try_take();
+        self.step_with(team.as_ref());
+    }
+
+    /// One step; with the team lock (held by the caller) the pair and particle passes run as
+    /// one team of threads (`team_step`), without it as two parallel loops (another system
+    /// holds the team: nested or concurrent use of the pool). The same bits either way.
+    pub fn step_with(&mut self, team: Option<&TeamLock>) {
         if !self.frozen && !self.x.is_empty() {
             if self.p.friction {
-                self.advance::<true>();
+                self.advance::<true>(team);
             } else {
-                self.advance::<false>();
+                self.advance::<false>(team);
             }
         }
         self.steps += 1;
         self.time += self.p.dt;
     }
 
-    fn advance<const FR: bool>(&mut self) {
+    fn advance<const FR: bool>(&mut self, team: Option<&TeamLock>) {
         let chunks = if self.p.work_chunks > 0 { self.p.work_chunks } else { 2 * rayon::current_num_threads() };
         if self.sc.bounds.is_empty() || self.sc_threads != chunks {
             self.sc.replan(&self.near.list, self.x.len(), chunks);
@@ -236,8 +244,8 @@ impl DemSystem {
             let h = self.p.dt;
             let b = weights(self.levels);
             let hb = [h * b[0], h * b[1], h * b[2]];
-            let st = match TeamLock::try_take() {
-                Some(_lock) => {
+            let st = match team {
+                Some(_) => {
                     let s = StepState {
                         x: &mut self.x,
                         v: &mut self.v,
@@ -250,8 +258,7 @@ impl DemSystem {
                     self.team_steps += 1;
                     team_step::<FR>(&self.p, hb, self.ring as usize, s, &self.x_near, &self.ext)
                 }
-                // Another system steps with a team now (nested or concurrent use of the pool):
-                // two parallel loops instead, which cannot wait on each other.
+                // Two parallel loops, which cannot wait on another team's threads.
                 None => {
                     let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
                     let m = Motion {
