@@ -76,14 +76,15 @@ impl<T> Raw<T> {
 
 /// At most one team at a time in the process: a team's threads spin at its barriers, so two
 /// teams sharing a pool could each wait for a thread the other holds. Whoever does not get the
-/// lock steps with plain parallel loops.
-pub struct TeamLock(());
+/// lock steps with plain parallel loops. Neither `Send` nor `Sync`, so the holder cannot hand it
+/// to the tasks of a parallel loop (which would start two teams on one pool).
+pub struct TeamLock(std::marker::PhantomData<*const ()>);
 
 static TEAM_BUSY: AtomicBool = AtomicBool::new(false);
 
 impl TeamLock {
     pub fn try_take() -> Option<TeamLock> {
-        TEAM_BUSY.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok().map(|_| TeamLock(()))
+        TEAM_BUSY.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok().map(|_| TeamLock(std::marker::PhantomData))
     }
 }
 
