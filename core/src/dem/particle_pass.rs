@@ -53,17 +53,21 @@ fn block_accel<const FR: bool>(
     }
 }
 
+/// The wall-list entries (sorted by particle) of block b of n particles.
+pub(super) fn block_walls(idx: &[u32], b: usize, n: usize) -> std::ops::Range<usize> {
+    let at = |p: usize| idx.partition_point(|&i| (i as usize) < p.min(n));
+    at(b * BLOCK)..at((b + 1) * BLOCK)
+}
+
 /// Wall-list entries split by block, for handing each block its own histories.
 fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> {
+    let (idx, mut hist) = (&walls.idx[..], &mut walls.hist[..]);
     let mut out = Vec::with_capacity(n.div_ceil(BLOCK));
-    let (mut idx, mut hist) = (&walls.idx[..], &mut walls.hist[..]);
     for b in 0..n.div_ceil(BLOCK) {
-        let hi = ((b + 1) * BLOCK).min(n);
-        let k = idx.partition_point(|&i| (i as usize) < hi);
-        let (i0, i1) = idx.split_at(k);
-        let (h0, h1) = std::mem::take(&mut hist).split_at_mut(k);
-        out.push((i0, h0));
-        (idx, hist) = (i1, h1);
+        let r = block_walls(idx, b, n);
+        let (h0, h1) = std::mem::take(&mut hist).split_at_mut(r.len());
+        out.push((&idx[r], h0));
+        hist = h1;
     }
     out
 }

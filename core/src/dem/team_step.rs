@@ -6,36 +6,31 @@
 //! passes (the same chunks, buffers and blocks), so every bit of the result is the same.
 
 use super::contact::V3;
-use super::forces::{chunk_pairs_dispatch, ChunkArgs, Past, Scratch, Stats};
+use super::forces::{chunk_pairs_dispatch, Acc, ChunkArgs, Past, Scratch, Stats};
 use super::neighbors::NeighborList;
-use super::particle_pass::{update_block_dispatch, BlockMotion, BLOCK};
+use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
-/// A barrier for the threads of one broadcast that spins (then yields) instead of sleeping.
+/// A one-use barrier for the threads of one broadcast that spins (then yields) instead of
+/// sleeping.
 struct SpinBarrier {
     arrived: AtomicUsize,
-    generation: AtomicUsize,
     n: usize,
 }
 
 impl SpinBarrier {
     fn new(n: usize) -> Self {
-        SpinBarrier { arrived: AtomicUsize::new(0), generation: AtomicUsize::new(0), n }
+        SpinBarrier { arrived: AtomicUsize::new(0), n }
     }
 
     /// Returns once all `n` threads have called it; writes before it are seen after it.
     fn wait(&self) {
-        let g = self.generation.load(Ordering::Acquire);
-        if self.arrived.fetch_add(1, Ordering::AcqRel) + 1 == self.n {
-            self.arrived.store(0, Ordering::Relaxed);
-            self.generation.store(g.wrapping_add(1), Ordering::Release);
-            return;
-        }
+        self.arrived.fetch_add(1, Ordering::AcqRel);
         let mut spins = 0u32;
-        while self.generation.load(Ordering::Acquire) == g {
+        while self.arrived.load(Ordering::Acquire) < self.n {
             if spins < 1 << 12 {
                 std::hint::spin_loop();
                 spins += 1;
@@ -53,7 +48,7 @@ struct Raw<T> {
     len: usize,
 }
 
-// SAFETY: `Raw` hands out references only under the phase rules of `team_steps`.
+// SAFETY: `Raw` hands out references only under the phase rules of `team_step`.
 unsafe impl<T: Send + Sync> Send for Raw<T> {}
 unsafe impl<T: Send + Sync> Sync for Raw<T> {}
 
@@ -116,9 +111,6 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
     assert!(start.len() > bounds.len() && bounds.iter().all(|&[a, b, e]| a <= b && b <= e && e <= n));
     let (nc, nb) = (bounds.len(), n.div_ceil(BLOCK));
-    // Each block's wall-list entries (the list is sorted by particle).
-    let wall_at = |b: usize| walls.idx.partition_point(|&i| (i as usize) < (b * BLOCK).min(n));
-    let wall_cut: Vec<usize> = (0..=nb).map(wall_at).collect();
     let widx = &walls.idx[..];
     let raw = Shared {
         x: Raw::new(x),
@@ -160,7 +152,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
         let sums = Sums { bounds, start, acc: unsafe { raw.acc.all() } };
         let older = 1 - ring;
         for b in t * nb / nt..(t + 1) * nb / nt {
-            let (lo, hi, w0, w1) = (b * BLOCK, ((b + 1) * BLOCK).min(n), wall_cut[b], wall_cut[b + 1]);
+            let (lo, hi, wr) = (b * BLOCK, ((b + 1) * BLOCK).min(n), block_walls(widx, b, n));
             let slot = |q: usize, s: usize| unsafe { raw.past[q][s].part(lo, hi) };
             let bm = BlockMotion {
                 lo,
@@ -169,8 +161,8 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 w: unsafe { raw.w.part(lo, hi) },
                 newer: [0, 1, 2].map(|q| &*slot(q, ring)),
                 older: [0, 1, 2].map(|q| slot(q, older)),
-                widx: &widx[w0..w1],
-                whist: unsafe { raw.whist.part(w0, w1) },
+                whist: unsafe { raw.whist.part(wr.start, wr.end) },
+                widx: &widx[wr],
             };
             st = st.max(update_block_dispatch::<FR>(p, hb, bm, x_ref, ext, sums));
         }
@@ -189,5 +181,5 @@ struct Shared {
     whist: Raw<[V3; 3]>,
     shear: Raw<V3>,
     touch: Raw<u8>,
-    acc: Raw<super::forces::Acc>,
+    acc: Raw<Acc>,
 }
