@@ -137,14 +137,14 @@ pub fn run() {
             let (outer, near) = sys.list_sizes();
             let per = |e: usize| e as f64 / sys.len() as f64;
             eprintln!(
-                "dem: {threads} thread(s), {:.3} s, state {:016x}, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes, {:.2} / {:.2} entries per particle, {:.2} touching",
+                "dem: {threads} thread(s), {:.3} s, state {:016x}, KE {:.3e} J, max overlap {:.2e} d, {builds} Verlet builds, {refreshes} near-list refreshes, {:.2} / {:.2} entries per particle, {} touching",
                 secs,
                 state_digest(&sys),
                 sys.kinetic_energy(),
                 sys.max_overlap_fraction(),
                 per(outer),
                 per(near),
-                per(sys.touching_pairs())
+                sys.touching_pairs().map_or("n/a (no friction)".into(), |t| format!("{:.2}", per(t)))
             );
             println!(
                 "{{\"bench\":\"{}\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",

@@ -144,9 +144,10 @@ impl DemSystem {
     pub fn list_sizes(&self) -> (usize, usize) {
         (self.outer.nbr.len(), self.near.list.nbr.len())
     }
-    /// Particle pairs touching at the last step.
-    pub fn touching_pairs(&self) -> usize {
-        self.near.list.touch.iter().filter(|&&t| t != 0).count()
+    /// Particle pairs touching at the last step; `None` without friction (no contact flags are
+    /// kept then). For diagnostics.
+    pub fn touching_pairs(&self) -> Option<usize> {
+        self.p.friction.then(|| self.near.list.touch.iter().filter(|&&t| t != 0).count())
     }
     pub fn is_frozen(&self) -> bool {
         self.frozen
