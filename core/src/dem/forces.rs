@@ -99,7 +99,6 @@ pub fn pair_pass<const FR: bool>(
     let (law, h) = (&p.pair, p.dt);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
-            acc.fill([0.0; 6]);
             let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w };
             match kernels {
                 Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
@@ -156,10 +155,11 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mu
 }
 
 /// The pair pass over rows a..b: distance checks, touching pairs batched and evaluated, forces
-/// added into `acc` (particles a..; the caller zeroes it before the first rows of a chunk).
+/// added into `acc` (particles a..).
 #[inline(always)]
 fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
+    acc.fill([0.0; 6]);
     let mut st = Stats::ZERO;
     let (base, end) = (offsets[a] as usize, offsets[b] as usize);
     let mut batch = Batch::new();
