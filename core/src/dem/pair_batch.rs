@@ -153,7 +153,10 @@ impl Default for Box<Batch> {
 /// The contact law over lanes 0..m, no branches (the same operations as `contact_force`).
 #[inline(always)]
 fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
-    let m = b.m;
+    // Whole vectors of 8: the lanes past b.m hold scratch (zeros or older pairs) whose results
+    // nobody reads. A count of b.m left the compiler a scalar tail of 1-8 lanes per batch, each
+    // several times the cost of a vector lane (docs/BENCHMARKS.md, "The lane loop's scalar tail").
+    let m = (b.m.min(CAP) + 7) & !7;
     let (kn, dn, ktl, dtl, mu, nt) = (law.kn, law.dn, law.kt, law.dt, law.mu, law.no_tension);
     for l in 0..m {
         let dist = b.r2[l].sqrt();
