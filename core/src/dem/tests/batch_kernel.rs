@@ -3,18 +3,26 @@
 
 use super::{test_case, with_damping};
 use crate::dem::contact::contact_force;
-use crate::dem::pair_batch::Batch;
+use crate::dem::pair_batch::{Batch, CAP};
 use crate::dem::DemParams;
 use rand::{Rng, SeedableRng};
 
 #[test]
 fn batched_pair_kernel_equals_the_scalar_contact_law() {
+    // 40 pairs fill five vectors of 8; 37 leave three lanes of the last one to scratch.
+    batch_against_scalar_law(40);
+    batch_against_scalar_law(37);
+}
+
+/// Lanes 0..n hold touching pairs; the lanes past n hold scratch (a zero pair, NaN, a huge
+/// overlap, all aimed at history slot 0), which the kernel computes with the rest but must
+/// never let into the forces, the histories or the returned maxima.
+fn batch_against_scalar_law(n: usize) {
     let case = with_damping(test_case(0.02, 0.02, false, 9.81, 1e-6), 0.1, 0.05, 0.3);
     let p = DemParams::new(&case);
     let r = p.radius;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
     let mut u = |s: f64| (rng.gen::<f64>() * 2.0 - 1.0) * s;
-    let n = 40;
     // Particle 2l and 2l+1 touch with a random overlap and random motion; random histories.
     let mut x = Vec::new();
     for l in 0..n {
@@ -35,6 +43,10 @@ fn batched_pair_kernel_equals_the_scalar_contact_law() {
             let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
             b.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
         }
+        for l in n..CAP {
+            let junk = [[0.0; 3], [f64::NAN; 3], [1e-9, 0.0, 0.0]][l % 3];
+            b.set(l, 0, 0, 1, junk, junk[0] * junk[0]);
+        }
         b.m = n;
         b
     };
@@ -44,18 +56,20 @@ fn batched_pair_kernel_equals_the_scalar_contact_law() {
     if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("bmi2") {
         let mut b2 = filled();
         let mut shear = shear0.clone();
-        b2.evaluate::<true, true>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
-        vector = Some((b2, shear));
+        let maxima = b2.evaluate::<true, true>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
+        vector = Some((b2, shear, maxima));
     }
     let mut shear = shear0.clone();
-    batch.evaluate::<true, false>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
-    if let Some((b2, s2)) = &vector {
+    let maxima = batch.evaluate::<true, false>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
+    if let Some((b2, s2, m2)) = &vector {
         // the AVX-512 gather (`pair_simd::gather8`) gives the same lanes as the portable one
-        assert_eq!(b2.f.as_flattened(), batch.f.as_flattened(), "vector gather: forces");
-        assert_eq!(b2.c.as_flattened(), batch.c.as_flattened(), "vector gather: torques");
+        let valid = |a: &[[f64; CAP]; 3]| a.map(|q| q[..n].to_vec());
+        assert_eq!(valid(&b2.f), valid(&batch.f), "vector gather: forces");
+        assert_eq!(valid(&b2.c), valid(&batch.c), "vector gather: torques");
         assert_eq!(s2, &shear, "vector gather: histories");
+        assert_eq!(m2, &maxima, "vector gather: maxima");
     }
-    let mut slid = 0;
+    let (mut slid, mut max_delta, mut max_excess) = (0, 0.0f64, f64::NEG_INFINITY);
     for l in 0..n {
         let (i, j) = (2 * l, 2 * l + 1);
         let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
@@ -70,7 +84,10 @@ fn batched_pair_kernel_equals_the_scalar_contact_law() {
         assert_eq!([batch.c[0][l], batch.c[1][l], batch.c[2][l]], cf.c, "torque of pair {l}");
         assert_eq!(shear[l], s, "history of pair {l}");
         slid += (cf.excess > -1e-30) as usize;
+        max_delta = max_delta.max(2.0 * r - dist);
+        max_excess = max_excess.max(cf.excess);
     }
+    assert_eq!(maxima, (max_delta, max_excess), "max overlap and Coulomb excess of the {n} pairs alone");
     assert!(slid > 0 && slid < n, "both sticking and sliding pairs exercised ({slid} of {n} slid)");
 }
 
