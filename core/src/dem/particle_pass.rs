@@ -13,12 +13,12 @@ use rayon::prelude::*;
 /// Particles per block of the particle pass.
 pub const BLOCK: usize = 256;
 
-/// Accelerations (a, α) of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices): the
-/// external force, then the chunk buffers in chunk order, walls for the wall-list entries
-/// `widx`/`whist`, gravity and the pour's extra damping.
+/// Force and n × F_t sums of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices):
+/// the external force, then the chunk buffers in chunk order, then walls for the wall-list
+/// entries `widx`/`whist`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn block_accel<const FR: bool>(
+fn block_forces<const FR: bool>(
     p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: Sums, widx: &[u32],
     whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
 ) {
@@ -43,14 +43,17 @@ fn block_accel<const FR: bool>(
         st.overlap = st.overlap.max(ov);
         st.coulomb_excess = st.coulomb_excess.max(ex);
     }
-    // a = F/m − g e_z − γ v, α = R (Σ n × F_t)/I − γ ω.
-    let (r, im, g, gz) = (p.radius, 1.0 / p.mass, p.extra_damping, p.gravity);
-    let ii = r / p.inertia;
-    for ((o, vi), wi) in out.iter_mut().zip(v).zip(w) {
-        let a = [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]];
-        let alpha = if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] };
-        *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
-    }
+}
+
+/// a = F/m − g e_z − γ v and α = R (Σ n × F_t)/I − γ ω (gravity and the pour's extra damping γ)
+/// of a particle with sums `o`, velocity `vi` and spin `wi`.
+#[inline(always)]
+fn accel_of<const FR: bool>(p: &DemParams, o: &Acc, vi: V3, wi: V3) -> (V3, V3) {
+    let (im, g, gz) = (1.0 / p.mass, p.extra_damping, p.gravity);
+    let ii = p.radius / p.inertia;
+    let a = [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]];
+    let alpha = if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] };
+    (a, alpha)
 }
 
 /// The wall-list entries (sorted by particle) of block b of n particles.
@@ -84,7 +87,12 @@ pub fn accel_pass<const FR: bool>(
         .map(|(b, (ob, (widx, whist)))| {
             let mut st = Stats::ZERO;
             let r = b * BLOCK..b * BLOCK + ob.len();
-            block_accel::<FR>(p, r.start, &x[r.clone()], &v[r.clone()], &w[r], ext, sc, widx, whist, ob, &mut st);
+            let (v, w) = (&v[r.clone()], &w[r.clone()]);
+            block_forces::<FR>(p, r.start, &x[r], v, w, ext, sc, widx, whist, ob, &mut st);
+            for ((o, &vi), &wi) in ob.iter_mut().zip(v).zip(w) {
+                let (a, alpha) = accel_of::<FR>(p, o, vi, wi);
+                *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
+            }
             st
         })
         .reduce(|| Stats::ZERO, Stats::max)
@@ -188,12 +196,12 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let mut st = Stats::ZERO;
     let mut acc = [[0.0; 6]; BLOCK];
     let acc = &mut acc[..len];
-    block_accel::<FR>(p, lo, x, v, w, ext, sc, widx, whist, acc, &mut st);
+    block_forces::<FR>(p, lo, x, v, w, ext, sc, widx, whist, acc, &mut st);
+    // Accelerations straight into the flat arrays the update reads.
     let mut a = [[0.0; 3]; BLOCK];
     let mut al = [[0.0; 3]; BLOCK];
-    for ((o, a), al) in acc.iter().zip(&mut a[..len]).zip(&mut al[..len]) {
-        *a = [o[0], o[1], o[2]];
-        *al = [o[3], o[4], o[5]];
+    for ((o, (&vi, &wi)), (a, al)) in acc.iter().zip(v.iter().zip(w.iter())).zip(a[..len].iter_mut().zip(&mut al[..len])) {
+        (*a, *al) = accel_of::<FR>(p, o, vi, wi);
     }
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
