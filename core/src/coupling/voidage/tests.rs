@@ -28,7 +28,7 @@ fn random_bed(g: &CylGrid, n: usize, a: f64, seed: u64) -> Vec<[f64; 3]> {
         .collect();
     p.push([0.0, 0.0, a]);
     p.push([g.radius - a, 0.0, g.height - a]);
-    p.push([(g.radius - a) * 0.7071067811865476, (g.radius - a) * 0.7071067811865476, 2.0 * g.dz]);
+    p.push([(g.radius - a) * std::f64::consts::FRAC_1_SQRT_2, (g.radius - a) * std::f64::consts::FRAC_1_SQRT_2, 2.0 * g.dz]);
     p
 }
 
