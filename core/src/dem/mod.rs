@@ -10,6 +10,7 @@
 //! - `forces`: the pair pass of a step (deterministic, parallel) and the shared types;
 //! - `work_split`: the pair pass's chunks and their force buffers;
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
+//! - `team_step`, `steal_ranges`: both passes of a step as one team of threads sharing the work;
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
 
@@ -22,6 +23,7 @@ pub mod neighbors;
 pub mod pair_batch;
 pub mod particle_pass;
 pub mod pair_simd;
+pub mod steal_ranges;
 pub mod system;
 pub mod team_step;
 pub mod walls;

@@ -244,7 +244,9 @@ impl DemSystem {
         let refresh_disp2 = self.p.near_move() * self.p.near_move();
         let st = if self.levels == 0 {
             let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
-            st1.max(self.heun::<FR>())
+            let st = st1.max(self.heun::<FR>());
+            self.sc.bounds.clear(); // replanned at the next step, now with the contacts' flags
+            st
         } else {
             let h = self.p.dt;
             let b = weights(self.levels);

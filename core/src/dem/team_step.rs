@@ -1,14 +1,16 @@
-//! One multistep DEM step as a single rayon broadcast: every thread of the pool takes a fixed
-//! share of the pair-pass chunks, waits at a spin barrier, then takes a fixed share of the
-//! particle-pass blocks. As two parallel loops (`forces::pair_pass`, then
-//! `particle_pass::update_pass`) the pool's threads fall asleep between the passes and must be
-//! woken (tens of µs a pass on a VM); here they spin instead. The work is that of the two
-//! passes (the same chunks, buffers and blocks), so every bit of the result is the same.
+//! One multistep DEM step as a single rayon broadcast: every thread of the pool takes pair-pass
+//! chunks (its own share first, then what is left of the others', `steal_ranges`), waits at a
+//! spin barrier, then takes particle-pass blocks the same way. As two parallel loops
+//! (`forces::pair_pass`, then `particle_pass::update_pass`) the pool's threads fall asleep
+//! between the passes and must be woken (tens of µs a pass on a VM); here they spin instead.
+//! The work is that of the two passes (the same chunks, buffers and blocks, whichever thread
+//! takes them), so every bit of the result is the same.
 
 use super::contact::V3;
 use super::forces::{chunk_pairs_dispatch, Acc, ChunkArgs, Past, Scratch, Stats};
 use super::neighbors::NeighborList;
 use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
+use super::steal_ranges::StealRanges;
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
@@ -124,6 +126,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
     };
     let team = rayon::current_num_threads();
     let phases = SpinBarrier::new(team);
+    let (chunk_queue, block_queue) = (StealRanges::new(nc, team), StealRanges::new(nb, team));
     let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
     let per_thread = rayon::broadcast(|ctx| {
         let (t, nt) = (ctx.index(), ctx.num_threads());
@@ -132,9 +135,10 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
         // A panic before the barrier is raised after it (the others would spin there for ever).
         let pairs = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
             // SAFETY: until the barrier x, v, w are only read; chunk c's histories, flags and
-            // buffer (disjoint from the other chunks') are written by its thread alone.
+            // buffer (disjoint from the other chunks') are written only by the thread that
+            // took c (each chunk is taken once).
             let (x, v, w) = unsafe { (raw.x.all(), raw.v.all(), raw.w.all()) };
-            for c in (0..nc).filter(|&c| c * nt / nc == t) {
+            while let Some(c) = chunk_queue.take(t) {
                 let [a, b, e] = bounds[c];
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
@@ -148,10 +152,11 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
             std::panic::resume_unwind(e);
         }
         // SAFETY: after the barrier the buffers are only read, and block b's particles and
-        // wall entries (disjoint from the other blocks') are touched by its thread alone.
+        // wall entries (disjoint from the other blocks') are touched only by the thread that
+        // took b (each block is taken once).
         let sums = Sums { bounds, start, acc: unsafe { raw.acc.all() } };
         let older = 1 - ring;
-        for b in t * nb / nt..(t + 1) * nb / nt {
+        while let Some(b) = block_queue.take(t) {
             let (lo, hi, wr) = (b * BLOCK, ((b + 1) * BLOCK).min(n), block_walls(widx, b, n));
             let slot = |q: usize, s: usize| unsafe { raw.past[q][s].part(lo, hi) };
             let bm = BlockMotion {
