@@ -99,7 +99,8 @@ pub fn pair_pass<const FR: bool>(
     let (law, h) = (&p.pair, p.dt);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
-            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w };
+            let e = a + acc.len();
+            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
             match kernels {
                 Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
                 Kernels::Portable => chunk_pairs::<FR, false>(&args, sh, to, acc),
@@ -119,6 +120,7 @@ pub(super) struct ChunkArgs<'a> {
     pub offsets: &'a [u32],
     pub nbr: &'a [u32],
     pub owner: &'a [u32],
+    /// Positions, velocities and spins of the chunk's window, particles a..e (rows and partners).
     pub x: &'a [V3],
     pub v: &'a [V3],
     pub w: &'a [V3],
@@ -155,7 +157,8 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mu
 }
 
 /// The pair pass over rows a..b: distance checks, touching pairs batched and evaluated, forces
-/// added into `acc` (particles a..).
+/// added into `acc` (particles a..). Particles are read only in the window a..e, and the batch
+/// lanes hold indices into it (particle − a).
 #[inline(always)]
 fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
@@ -168,30 +171,31 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: 
     // advance m.
     let mut m = 0;
     assert!(owner.len() == nbr.len() && end <= nbr.len() && x.len() <= i32::MAX as usize / 3);
+    assert!(acc.len() == x.len() && v.len() == x.len() && (w.len() == x.len() || !FR), "chunk window");
     let mut k = base;
     #[cfg(target_arch = "x86_64")]
     if V {
         while k + LANES <= end {
             if m > CAP - LANES {
                 batch.m = m;
-                flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+                flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
                 m = 0;
             }
             // SAFETY: V is set only by the caller compiled for (and checked to have) the
             // features; bounds as asserted above and in `Scratch::plan`.
-            m = unsafe { scan8::<FR>(k, base, owner, nbr, x, d2, to, &mut batch, m) };
+            m = unsafe { scan8::<FR>(k, base, a, owner, nbr, x, d2, to, &mut batch, m) };
             k += LANES;
         }
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
             m = 0;
         }
     }
     for k in k..end {
         // SAFETY: k < end ≤ nbr.len() = owner.len() (asserted); `Scratch::plan` checked
-        // i < j < x.len() for every listed pair, and the chunk's `to` covers k - base.
-        let (i, j) = unsafe { (*owner.get_unchecked(k) as usize, *nbr.get_unchecked(k) as usize) };
+        // a ≤ i < j < e for every pair of the chunk, and the chunk's `to` covers k - base.
+        let (i, j) = unsafe { (*owner.get_unchecked(k) as usize - a, *nbr.get_unchecked(k) as usize - a) };
         let (xi, xj) = unsafe { (*x.get_unchecked(i), *x.get_unchecked(j)) };
         let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
         let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
@@ -206,27 +210,27 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: 
         m += touching as usize;
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
             m = 0;
         }
     }
     batch.m = m;
-    flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, a, acc, &mut st);
+    flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
     st
 }
 
-/// Evaluate a batch and add its forces into `acc` (particles a..).
+/// Evaluate a batch and add its forces into `acc` (the chunk window, as the lane indices).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
-    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [V3], base: usize, a: usize,
+    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [V3], base: usize,
     acc: &mut [Acc], st: &mut Stats,
 ) {
     let (ov, ex) = batch.evaluate::<FR, V>(law, r, h, v, w, sh, base);
     st.overlap = st.overlap.max(ov);
     st.coulomb_excess = st.coulomb_excess.max(ex);
     for l in 0..batch.m {
-        let (ii, jj) = (batch.i[l] as usize - a, batch.j[l] as usize - a);
+        let (ii, jj) = (batch.i[l] as usize, batch.j[l] as usize);
         let f = [batch.f[0][l], batch.f[1][l], batch.f[2][l]];
         let c = if FR { [batch.c[0][l], batch.c[1][l], batch.c[2][l]] } else { [0.0; 3] };
         // F on i, −F on j; both partners feel R n × F_t (contact points ±R n, forces ±F_t).

@@ -16,20 +16,24 @@ use super::pair_batch::{Batch, CAP};
 pub const LANES: usize = 8;
 
 /// Entries k..k+8 (rows `owner`, partners `nbr`, flags `to[k - base..]` when FR) into `batch`
-/// from lane m (≤ CAP − 8); returns the new lane count.
+/// from lane m (≤ CAP − 8), with particle indices relative to the window `x` = particles
+/// `first`..; returns the new lane count.
 ///
 /// # Safety
 /// The CPU has avx512f, avx512vl and bmi2; k + 8 ≤ owner.len() = nbr.len(); every owner and
-/// partner index < x.len() ≤ i32::MAX / 3; k − base + 8 ≤ to.len() when FR; m ≤ CAP − 8.
+/// partner index − first is in 0..x.len(), x.len() ≤ i32::MAX / 3; k − base + 8 ≤ to.len()
+/// when FR; m ≤ CAP − 8.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn scan8<const FR: bool>(
-    k: usize, base: usize, owner: &[u32], nbr: &[u32], x: &[V3], d2: f64, to: &mut [u8], batch: &mut Batch, m: usize,
+    k: usize, base: usize, first: usize, owner: &[u32], nbr: &[u32], x: &[V3], d2: f64, to: &mut [u8], batch: &mut Batch,
+    m: usize,
 ) -> usize {
     debug_assert!(k + LANES <= owner.len() && k + LANES <= nbr.len() && m <= CAP - LANES);
-    let oi = _mm256_loadu_si256(owner.as_ptr().add(k) as *const __m256i);
-    let oj = _mm256_loadu_si256(nbr.as_ptr().add(k) as *const __m256i);
+    let at = _mm256_set1_epi32(first as i32);
+    let oi = _mm256_sub_epi32(_mm256_loadu_si256(owner.as_ptr().add(k) as *const __m256i), at);
+    let oj = _mm256_sub_epi32(_mm256_loadu_si256(nbr.as_ptr().add(k) as *const __m256i), at);
     // f64 offsets of x[i][0]: 3 i.
     let (ti, tj) = (_mm256_add_epi32(_mm256_add_epi32(oi, oi), oi), _mm256_add_epi32(_mm256_add_epi32(oj, oj), oj));
     let p = x.as_ptr() as *const f64;

@@ -29,7 +29,7 @@ fn block_forces<const FR: bool>(
     for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
         let (s, t) = (lo.max(a), hi.min(e));
         if s < t {
-            let buf = &sc.acc[sc.start[c] + s - a..sc.start[c] + t - a];
+            let buf = sc.rows(c, s, t);
             for (o, q) in out[s - lo..t - lo].iter_mut().zip(buf) {
                 for k in 0..6 {
                     o[k] += q[k];

@@ -1,10 +1,12 @@
 //! One multistep DEM step as a single rayon broadcast: every thread of the pool takes pair-pass
-//! chunks (its own share first, then what is left of the others', `steal_ranges`), waits at a
-//! spin barrier, then takes particle-pass blocks the same way. As two parallel loops
-//! (`forces::pair_pass`, then `particle_pass::update_pass`) the pool's threads fall asleep
-//! between the passes and must be woken (tens of µs a pass on a VM); here they spin instead.
-//! The work is that of the two passes (the same chunks, buffers and blocks, whichever thread
-//! takes them), so every bit of the result is the same.
+//! chunks (its own share first, then what is left of the others', `steal_ranges`), then
+//! particle-pass blocks the same way. There is no barrier between the passes: a block waits
+//! (spinning) only for the chunks whose particle windows cover it — they read its particles and
+//! write its force sums — so a thread whose pair pass ran long hands blocks to the others
+//! instead of making them wait. As two parallel loops (`forces::pair_pass`, then
+//! `particle_pass::update_pass`) the pool's threads fall asleep between the passes and must be
+//! woken (tens of µs a pass on a VM). The work is that of the two passes (the same chunks,
+//! buffers and blocks, whichever thread takes them), so every bit of the result is the same.
 
 use super::contact::V3;
 use super::forces::{chunk_pairs_dispatch, Acc, ChunkArgs, Past, Scratch, Stats};
@@ -14,25 +16,17 @@ use super::steal_ranges::StealRanges;
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, Ordering};
 
-/// A one-use barrier for the threads of one broadcast that spins (then yields) instead of
-/// sleeping.
-struct SpinBarrier {
-    arrived: AtomicUsize,
-    n: usize,
-}
-
-impl SpinBarrier {
-    fn new(n: usize) -> Self {
-        SpinBarrier { arrived: AtomicUsize::new(0), n }
-    }
-
-    /// Returns once all `n` threads have called it; writes before it are seen after it.
-    fn wait(&self) {
-        self.arrived.fetch_add(1, Ordering::AcqRel);
+/// Spins (then yields) until every chunk c with `need(c)` is done; false if a chunk failed
+/// (its thread panicked), so that nobody waits for it for ever.
+fn wait_for_chunks(done: &[AtomicBool], failed: &AtomicBool, need: impl Fn(usize) -> bool) -> bool {
+    for c in (0..done.len()).filter(|&c| need(c)) {
         let mut spins = 0u32;
-        while self.arrived.load(Ordering::Acquire) < self.n {
+        while !done[c].load(Ordering::Acquire) {
+            if failed.load(Ordering::Acquire) {
+                return false;
+            }
             if spins < 1 << 12 {
                 std::hint::spin_loop();
                 spins += 1;
@@ -41,6 +35,7 @@ impl SpinBarrier {
             }
         }
     }
+    true
 }
 
 /// A slice the team reads whole in one phase and writes in disjoint pieces in another.
@@ -59,11 +54,6 @@ impl<T> Raw<T> {
         Raw { ptr: s.as_mut_ptr(), len: s.len() }
     }
     /// # Safety
-    /// No mutable reference into the slice is live while the returned one is.
-    unsafe fn all<'a>(self) -> &'a [T] {
-        std::slice::from_raw_parts(self.ptr, self.len)
-    }
-    /// # Safety
     /// No other reference into lo..hi is live while the returned one is.
     unsafe fn part<'a>(self, lo: usize, hi: usize) -> &'a mut [T] {
         assert!(lo <= hi && hi <= self.len, "piece {lo}..{hi} of {}", self.len);
@@ -71,7 +61,7 @@ impl<T> Raw<T> {
     }
 }
 
-/// At most one team at a time in the process: a team's threads spin at its barriers, so two
+/// At most one team at a time in the process: a team's threads spin while they wait, so two
 /// teams sharing a pool could each wait for a thread the other holds. Whoever does not get the
 /// lock steps with plain parallel loops. Neither `Send` nor `Sync`, so the holder cannot hand it
 /// to the tasks of a parallel loop (which would start two teams on one pool).
@@ -125,39 +115,47 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
         acc: Raw::new(&mut sc.acc),
     };
     let team = rayon::current_num_threads();
-    let phases = SpinBarrier::new(team);
-    let (chunk_queue, block_queue) = (StealRanges::new(nc, team), StealRanges::new(nb, team));
+    // Chunks: each thread starts at the end of its share, next to the following thread's,
+    // whose first blocks wait for it (a chunk's window reaches into the particles after it).
+    let (chunk_queue, block_queue) = (StealRanges::new(nc, team, true), StealRanges::new(nb, team, false));
+    let done: Vec<AtomicBool> = (0..nc).map(|_| AtomicBool::new(false)).collect();
+    let failed = AtomicBool::new(false);
     let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
     let per_thread = rayon::broadcast(|ctx| {
         let (t, nt) = (ctx.index(), ctx.num_threads());
         assert!(nt == team, "broadcast on the pool that was counted");
         let mut st = Stats::ZERO;
-        // A panic before the barrier is raised after it (the others would spin there for ever).
+        // A panic in a chunk marks the team failed (no block waits for that chunk for ever).
         let pairs = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            // SAFETY: until the barrier x, v, w are only read; chunk c's histories, flags and
-            // buffer (disjoint from the other chunks') are written only by the thread that
-            // took c (each chunk is taken once).
-            let (x, v, w) = unsafe { (raw.x.all(), raw.v.all(), raw.w.all()) };
             while let Some(c) = chunk_queue.take(t) {
                 let [a, b, e] = bounds[c];
+                // SAFETY: chunk c reads x, v, w only in its window a..e, which no block
+                // writes before c is done; its histories, flags and buffer (disjoint from the
+                // other chunks') are written only by the thread that took c (taken once).
+                let (x, v, w) = unsafe { (&*raw.x.part(a, e), &*raw.v.part(a, e), &*raw.w.part(a, e)) };
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
                 let args = ChunkArgs { law: &p.pair, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
                 st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
+                done[c].store(true, Ordering::Release);
             }
         }));
-        phases.wait();
         if let Err(e) = pairs {
+            failed.store(true, Ordering::Release);
             std::panic::resume_unwind(e);
         }
-        // SAFETY: after the barrier the buffers are only read, and block b's particles and
-        // wall entries (disjoint from the other blocks') are touched only by the thread that
-        // took b (each block is taken once).
-        let sums = Sums { bounds, start, acc: unsafe { raw.acc.all() } };
         let older = 1 - ring;
         while let Some(b) = block_queue.take(t) {
             let (lo, hi, wr) = (b * BLOCK, ((b + 1) * BLOCK).min(n), block_walls(widx, b, n));
+            // Block b's particles lie in the windows of the chunks that overlap it.
+            if !wait_for_chunks(&done, &failed, |c| bounds[c][0] < hi && bounds[c][2] > lo) {
+                break; // another thread's chunk panicked; its panic reaches the caller
+            }
+            // SAFETY: every chunk that reads block b's particles or writes their buffer rows
+            // is done (the buffer rows of the other chunks' windows are not read here); b's
+            // particles and wall entries are touched only by the thread that took b.
+            let sums = unsafe { Sums::from_raw(bounds, start, raw.acc.ptr, raw.acc.len) };
             let slot = |q: usize, s: usize| unsafe { raw.past[q][s].part(lo, hi) };
             let bm = BlockMotion {
                 lo,

@@ -25,17 +25,51 @@ pub struct Scratch {
     pub owner: Vec<u32>,
 }
 
-/// The chunk buffers as the particle pass reads them.
+/// The chunk buffers as the particle pass reads them: a read-only view that hands out only the
+/// rows asked for (`rows`), so that in the team step a block can read the buffers of finished
+/// chunks while other chunks still write theirs.
 #[derive(Clone, Copy)]
 pub struct Sums<'a> {
     pub bounds: &'a [[usize; 3]],
-    pub start: &'a [usize],
-    pub acc: &'a [Acc],
+    start: &'a [usize],
+    acc: *const Acc,
+    len: usize,
+    life: std::marker::PhantomData<&'a [Acc]>,
+}
+
+// SAFETY: a read-only view; `Sums::new` borrows the buffers, `Sums::from_raw`'s caller keeps
+// every row read through it unwritten while it is read.
+unsafe impl Send for Sums<'_> {}
+unsafe impl Sync for Sums<'_> {}
+
+impl<'a> Sums<'a> {
+    pub fn new(bounds: &'a [[usize; 3]], start: &'a [usize], acc: &'a [Acc]) -> Self {
+        // SAFETY: `acc` is borrowed (shared) for 'a.
+        unsafe { Self::from_raw(bounds, start, acc.as_ptr(), acc.len()) }
+    }
+
+    /// # Safety
+    /// `acc` points to `len` buffers rows valid for 'a, and no row read through `rows` is
+    /// written while the returned slice lives.
+    pub unsafe fn from_raw(bounds: &'a [[usize; 3]], start: &'a [usize], acc: *const Acc, len: usize) -> Self {
+        assert!(start.len() > bounds.len() && bounds.iter().zip(start).all(|(&[a, _, e], &s)| s + e - a <= len), "chunk buffers");
+        Sums { bounds, start, acc, len, life: std::marker::PhantomData }
+    }
+
+    /// Chunk c's buffer rows of particles s..t (within its window a..e).
+    pub fn rows(&self, c: usize, s: usize, t: usize) -> &'a [Acc] {
+        let [a, _, e] = self.bounds[c];
+        assert!(a <= s && s <= t && t <= e, "rows {s}..{t} outside chunk window {a}..{e}");
+        let lo = self.start[c] + s - a;
+        assert!(lo + t - s <= self.len);
+        // SAFETY: in bounds (checked in `from_raw` and above); not written meanwhile (contract).
+        unsafe { std::slice::from_raw_parts(self.acc.add(lo), t - s) }
+    }
 }
 
 impl Scratch {
     pub fn sums(&self) -> Sums<'_> {
-        Sums { bounds: &self.bounds, start: &self.start, acc: &self.acc }
+        Sums::new(&self.bounds, &self.start, &self.acc)
     }
 
     /// Plan `chunks` chunks (fewer for small systems) over the list.
