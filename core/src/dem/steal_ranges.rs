@@ -3,7 +3,7 @@
 //! the other end of the others'. Each item is taken exactly once, so work whose result does
 //! not depend on who does it (the pair-pass chunks, the particle blocks) stays bit-identical,
 //! while a thread slowed down for a while (a busy neighbour on a VM, more contacts in its part
-//! of the bed) hands its last items to the others instead of making them wait at the barrier.
+//! of the bed) hands its last items to the others instead of making them wait for it.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 

@@ -38,7 +38,7 @@ fn wait_for_chunks(done: &[AtomicBool], failed: &AtomicBool, need: impl Fn(usize
     true
 }
 
-/// A slice the team reads whole in one phase and writes in disjoint pieces in another.
+/// A slice the team reads in (possibly overlapping) windows and writes in disjoint pieces.
 #[derive(Clone, Copy)]
 struct Raw<T> {
     ptr: *mut T,
@@ -52,6 +52,12 @@ unsafe impl<T: Send + Sync> Sync for Raw<T> {}
 impl<T> Raw<T> {
     fn new(s: &mut [T]) -> Self {
         Raw { ptr: s.as_mut_ptr(), len: s.len() }
+    }
+    /// # Safety
+    /// No mutable reference into lo..hi is live while the returned one is.
+    unsafe fn view<'a>(self, lo: usize, hi: usize) -> &'a [T] {
+        assert!(lo <= hi && hi <= self.len, "view {lo}..{hi} of {}", self.len);
+        std::slice::from_raw_parts(self.ptr.add(lo), hi - lo)
     }
     /// # Safety
     /// No other reference into lo..hi is live while the returned one is.
@@ -132,7 +138,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 // SAFETY: chunk c reads x, v, w only in its window a..e, which no block
                 // writes before c is done; its histories, flags and buffer (disjoint from the
                 // other chunks') are written only by the thread that took c (taken once).
-                let (x, v, w) = unsafe { (&*raw.x.part(a, e), &*raw.v.part(a, e), &*raw.w.part(a, e)) };
+                let (x, v, w) = unsafe { (raw.x.view(a, e), raw.v.view(a, e), raw.w.view(a, e)) };
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };

@@ -1,4 +1,4 @@
-//! The team step (one broadcast per step, threads meeting at a spin barrier) against the two
+//! The team step (one broadcast per step, threads sharing chunks and blocks) against the two
 //! parallel loops it replaces: the same bits. Systems stepped at once on one pool (nested in a
 //! parallel loop, so one holds the team and the other takes the plain loops) neither deadlock
 //! nor change their results.
