@@ -67,6 +67,10 @@ impl<T> Raw<T> {
     }
 }
 
+/// Tests only: chunk c panics while this holds c + 1 (set only by a test holding the team lock).
+#[cfg(test)]
+pub(crate) static PANIC_IN_CHUNK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
 /// At most one team at a time in the process: a team's threads spin while they wait, so two
 /// teams sharing a pool could each wait for a thread the other holds. Whoever does not get the
 /// lock steps with plain parallel loops. Neither `Send` nor `Sync`, so the holder cannot hand it
@@ -143,6 +147,8 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
                 let args = ChunkArgs { law: &p.pair, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
+                #[cfg(test)]
+                assert!(PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1, "injected panic in chunk {c}");
                 st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
                 done[c].store(true, Ordering::Release);
             }
