@@ -7,6 +7,7 @@ use crate::job::{now_rfc3339, SnapshotInfo, Status};
 use crate::App;
 use anyhow::Result;
 use fluidbed_core::case::Case;
+use fluidbed_core::dem::team_step::pool_with_own_team;
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::Simulation;
 use std::collections::VecDeque;
@@ -111,7 +112,8 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
         app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
     }
     let threads = app.config.threads_per_job.max(1);
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
+    // Its own team lock, so that concurrent jobs each step DEM as a team (`team_step`).
+    let pool = pool_with_own_team().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
     let base_wall = job.wall_s;
     pool.install(|| drive(app, id, &cancel, base_wall))
 }

@@ -16,7 +16,9 @@ use super::steal_ranges::StealRanges;
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
+use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
 
 /// Spins (then yields) until every chunk c with `need(c)` is done; false if a chunk failed
 /// (its thread panicked), so that nobody waits for it for ever.
@@ -67,27 +69,54 @@ impl<T> Raw<T> {
     }
 }
 
-/// Tests only: chunk c panics while this holds c + 1 (set only by a test holding the team lock).
+/// Tests only: chunk c panics while this holds c + 1, on pools without their own team lock (the
+/// test that sets it holds the process-wide lock, so no other such team runs meanwhile).
 #[cfg(test)]
 pub(crate) static PANIC_IN_CHUNK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-/// At most one team at a time in the process: a team's threads spin while they wait, so two
-/// teams sharing a pool could each wait for a thread the other holds. Whoever does not get the
-/// lock steps with plain parallel loops. Neither `Send` nor `Sync`, so the holder cannot hand it
-/// to the tasks of a parallel loop (which would start two teams on one pool).
-pub struct TeamLock(std::marker::PhantomData<*const ()>);
+/// At most one team at a time per pool: a team's threads spin while they wait, so two teams
+/// sharing a pool could each wait for a thread the other holds. Pools built by
+/// `pool_with_own_team` have a lock each; every other pool (and code outside any pool) shares
+/// one process-wide lock. Whoever does not get the lock steps with plain parallel loops. Neither
+/// `Send` nor `Sync`, so the holder cannot hand it to the tasks of a parallel loop (which would
+/// start two teams on one pool).
+pub struct TeamLock {
+    flag: Option<Arc<AtomicBool>>,
+    not_send: std::marker::PhantomData<*const ()>,
+}
 
 static TEAM_BUSY: AtomicBool = AtomicBool::new(false);
 
+thread_local! {
+    /// The team flag of the pool this thread works for, if it was built by `pool_with_own_team`.
+    static POOL_TEAM: RefCell<Option<Arc<AtomicBool>>> = const { RefCell::new(None) };
+}
+
+/// A pool builder whose pool gets its own team lock, so that systems stepped on different such
+/// pools at once (the server's concurrent jobs) each run as a team.
+pub fn pool_with_own_team() -> rayon::ThreadPoolBuilder {
+    let flag = Arc::new(AtomicBool::new(false));
+    rayon::ThreadPoolBuilder::new().start_handler(move |_| POOL_TEAM.with(|p| *p.borrow_mut() = Some(flag.clone())))
+}
+
+#[cfg(test)]
+fn has_own_team() -> bool {
+    POOL_TEAM.with(|p| p.borrow().is_some())
+}
+
 impl TeamLock {
+    /// The lock of the current thread's pool (the pool a broadcast from here runs on).
     pub fn try_take() -> Option<TeamLock> {
-        TEAM_BUSY.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok().map(|_| TeamLock(std::marker::PhantomData))
+        let flag = POOL_TEAM.with(|p| p.borrow().clone());
+        let busy = flag.as_deref().unwrap_or(&TEAM_BUSY);
+        busy.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok()?;
+        Some(TeamLock { flag, not_send: std::marker::PhantomData })
     }
 }
 
 impl Drop for TeamLock {
     fn drop(&mut self) {
-        TEAM_BUSY.store(false, Ordering::Release);
+        self.flag.as_deref().unwrap_or(&TEAM_BUSY).store(false, Ordering::Release);
     }
 }
 
@@ -148,7 +177,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
                 let args = ChunkArgs { law: &p.pair, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
                 #[cfg(test)]
-                assert!(PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1, "injected panic in chunk {c}");
+                assert!(PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1 || has_own_team(), "injected panic in chunk {c}");
                 st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
                 done[c].store(true, Ordering::Release);
             }

@@ -1,11 +1,11 @@
 //! The team step (one broadcast per step, threads sharing chunks and blocks) against the two
 //! parallel loops it replaces: the same bits. Systems stepped at once on one pool (nested in a
 //! parallel loop, so one holds the team and the other takes the plain loops) neither deadlock
-//! nor change their results. A panic in one thread's chunk reaches the caller instead of
+//! nor change their results; on pools with their own team lock, both run as teams. A panic in one thread's chunk reaches the caller instead of
 //! leaving the other thread waiting for that chunk.
 
 use super::checkpoint::{busy_system, same_state};
-use crate::dem::team_step::{TeamLock, PANIC_IN_CHUNK};
+use crate::dem::team_step::{pool_with_own_team, TeamLock, PANIC_IN_CHUNK};
 use std::sync::atomic::Ordering;
 use crate::dem::DemSystem;
 use rayon::prelude::*;
@@ -81,4 +81,25 @@ fn a_panic_in_a_chunk_reaches_the_caller_without_a_hang() {
     let outcome = rx.recv_timeout(std::time::Duration::from_secs(120)).expect("the team hung after a chunk panicked");
     let msg = outcome.expect_err("the injected panic did not reach the caller");
     assert!(msg.contains("injected panic in chunk 0"), "{msg}");
+}
+
+#[test]
+fn systems_on_pools_with_their_own_team_lock_both_run_as_teams() {
+    let run = || {
+        let mut s = busy_system();
+        for _ in 0..STEPS {
+            s.step();
+        }
+        s
+    };
+    let alone = pool().install(run);
+    let pools: Vec<rayon::ThreadPool> = (0..2).map(|_| pool_with_own_team().num_threads(2).build().unwrap()).collect();
+    let both: Vec<DemSystem> = std::thread::scope(|sc| {
+        let hs: Vec<_> = pools.iter().map(|p| sc.spawn(move || p.install(run))).collect();
+        hs.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    for s in &both {
+        assert_eq!(s.team_steps(), STEPS as u64 - 1, "a system on its own pool did not get its team");
+        assert!(same_state(s, &alone));
+    }
 }
