@@ -186,6 +186,9 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
             failed.store(true, Ordering::Release);
             std::panic::resume_unwind(e);
         }
+        // SAFETY: rows are read through `sums` only for a block whose chunks are done (below);
+        // the other chunks' buffer rows are not read.
+        let sums = unsafe { Sums::from_raw(bounds, start, raw.acc.ptr, raw.acc.len) };
         let older = 1 - ring;
         while let Some(b) = block_queue.take(t) {
             let (lo, hi, wr) = (b * BLOCK, ((b + 1) * BLOCK).min(n), block_walls(widx, b, n));
@@ -194,9 +197,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 break; // another thread's chunk panicked; its panic reaches the caller
             }
             // SAFETY: every chunk that reads block b's particles or writes their buffer rows
-            // is done (the buffer rows of the other chunks' windows are not read here); b's
-            // particles and wall entries are touched only by the thread that took b.
-            let sums = unsafe { Sums::from_raw(bounds, start, raw.acc.ptr, raw.acc.len) };
+            // is done; b's particles and wall entries are touched only by the thread that took b.
             let slot = |q: usize, s: usize| unsafe { raw.past[q][s].part(lo, hi) };
             let bm = BlockMotion {
                 lo,

@@ -1,14 +1,14 @@
 //! The team step (one broadcast per step, threads sharing chunks and blocks) against the two
 //! parallel loops it replaces: the same bits. Systems stepped at once on one pool (nested in a
 //! parallel loop, so one holds the team and the other takes the plain loops) neither deadlock
-//! nor change their results; on pools with their own team lock, both run as teams. A panic in one thread's chunk reaches the caller instead of
-//! leaving the other thread waiting for that chunk.
+//! nor change their results; on pools with their own team lock, both run as teams. A panic in
+//! one thread's chunk reaches the caller instead of leaving the other thread waiting for it.
 
 use super::checkpoint::{busy_system, same_state};
 use crate::dem::team_step::{pool_with_own_team, TeamLock, PANIC_IN_CHUNK};
-use std::sync::atomic::Ordering;
 use crate::dem::DemSystem;
 use rayon::prelude::*;
+use std::sync::atomic::Ordering;
 
 const STEPS: usize = 1500;
 
@@ -19,6 +19,15 @@ fn take_team_lock() -> TeamLock {
             None => std::thread::yield_now(),
         }
     }
+}
+
+/// The busy system after STEPS plain `step()` calls (team or loops, whichever it gets).
+fn run_busy() -> DemSystem {
+    let mut s = busy_system();
+    for _ in 0..STEPS {
+        s.step();
+    }
+    s
 }
 
 fn pool() -> rayon::ThreadPool {
@@ -48,14 +57,7 @@ fn team_step_equals_the_plain_passes() {
 
 #[test]
 fn systems_stepped_in_a_parallel_loop_match_one_stepped_alone() {
-    let run = || {
-        let mut s = busy_system();
-        for _ in 0..STEPS {
-            s.step();
-        }
-        s
-    };
-    let (nested, alone): (Vec<DemSystem>, DemSystem) = pool().install(|| ((0..2).into_par_iter().map(|_| run()).collect(), run()));
+    let (nested, alone): (Vec<DemSystem>, DemSystem) = pool().install(|| ((0..2).into_par_iter().map(|_| run_busy()).collect(), run_busy()));
     assert!(nested.iter().all(|s| same_state(s, &alone)));
 }
 
@@ -85,17 +87,10 @@ fn a_panic_in_a_chunk_reaches_the_caller_without_a_hang() {
 
 #[test]
 fn systems_on_pools_with_their_own_team_lock_both_run_as_teams() {
-    let run = || {
-        let mut s = busy_system();
-        for _ in 0..STEPS {
-            s.step();
-        }
-        s
-    };
-    let alone = pool().install(run);
+    let alone = pool().install(run_busy);
     let pools: Vec<rayon::ThreadPool> = (0..2).map(|_| pool_with_own_team().num_threads(2).build().unwrap()).collect();
     let both: Vec<DemSystem> = std::thread::scope(|sc| {
-        let hs: Vec<_> = pools.iter().map(|p| sc.spawn(move || p.install(run))).collect();
+        let hs: Vec<_> = pools.iter().map(|p| sc.spawn(move || p.install(run_busy))).collect();
         hs.into_iter().map(|h| h.join().unwrap()).collect()
     });
     for s in &both {
