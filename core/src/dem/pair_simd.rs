@@ -4,6 +4,10 @@
 //!   touching ones into the next batch lanes (the scalar scan is in `forces`);
 //! - `gather8`: the velocities, spins and live histories of eight batch lanes (the scalar
 //!   gather is in `Batch::evaluate`).
+//!
+//! The row side of eight entries or lanes (x_i, v_i, ω_i) and their history slots are ascending
+//! and close together, so `Rows` loads them as two or four whole vectors and permutes instead
+//! of gathering (docs/BENCHMARKS.md, "Rows by permute").
 
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
@@ -37,9 +41,12 @@ pub unsafe fn scan8<const FR: bool>(
     // f64 offsets of x[i][0]: 3 i.
     let (ti, tj) = (_mm256_add_epi32(_mm256_add_epi32(oi, oi), oi), _mm256_add_epi32(_mm256_add_epi32(oj, oj), oj));
     let p = x.as_ptr() as *const f64;
+    // The rows of eight consecutive entries are ascending (the list's order).
+    let (i0, i7) = (*owner.get_unchecked(k) as usize - first, *owner.get_unchecked(k + 7) as usize - first);
+    let rows = Rows::new(p, i0, i7, x.len(), ti, 0xff);
     let mut dx = [_mm512_setzero_pd(); 3];
     for (a, d) in dx.iter_mut().enumerate() {
-        let xi = _mm512_i32gather_pd::<8>(ti, p.add(a));
+        let xi = rows.component(a);
         let xj = _mm512_i32gather_pd::<8>(tj, p.add(a));
         *d = _mm512_sub_pd(xj, xi);
     }
@@ -90,8 +97,12 @@ pub unsafe fn gather8<const FR: bool>(
     let (ti, tj) = (three(oi), three(oj));
     let z = _mm512_setzero_pd();
     let vp = v.as_ptr() as *const f64;
+    // Lanes keep the entries' order, so rows and slots ascend from the first to the last valid lane.
+    let last = l + 7 - valid.leading_zeros() as usize;
+    let (i0, il) = (*batch.i.get_unchecked(l) as usize, *batch.i.get_unchecked(last) as usize);
+    let vrows = Rows::new(vp, i0, il, v.len(), ti, valid);
     for q in 0..3 {
-        let vi = _mm512_mask_i32gather_pd::<8>(z, valid, ti, vp.add(q));
+        let vi = vrows.component(q);
         let vj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, vp.add(q));
         _mm512_storeu_pd(batch.vrel[q].as_mut_ptr().add(l), _mm512_sub_pd(vi, vj));
     }
@@ -105,11 +116,113 @@ pub unsafe fn gather8<const FR: bool>(
     let tk = three(kk);
     const BYTES: u64 = 0x0101_0101_0101_0101;
     let live = valid & _pext_u64((batch.was.as_ptr().add(l) as *const u64).read_unaligned(), BYTES) as __mmask8;
+    let wrows = Rows::new(wp, i0, il, w.len(), ti, valid);
+    let (k0, kl) = (*batch.k.get_unchecked(l) as usize - base, *batch.k.get_unchecked(last) as usize - base);
+    let slots = Rows::new(sp, k0, kl, shear.len(), tk, live);
     for q in 0..3 {
-        let wi = _mm512_mask_i32gather_pd::<8>(z, valid, ti, wp.add(q));
+        let wi = wrows.component(q);
         let wj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, wp.add(q));
         _mm512_storeu_pd(batch.ws[q].as_mut_ptr().add(l), _mm512_mul_pd(rr, _mm512_add_pd(wi, wj)));
-        let sq = _mm512_mask_i32gather_pd::<8>(z, live, tk, sp.add(q));
+        let sq = slots.component(q);
         _mm512_storeu_pd(batch.s[q].as_mut_ptr().add(l), sq);
+    }
+}
+
+/// Component q of eight lanes' records (a V3 array at `p` of `len` records, lanes `valid`,
+/// offsets `t` = 3 i, ascending, first lane i0, last valid lane il): from two or four vector
+/// loads and permutes when the lanes span at most five or ten records, else a gather (the same
+/// values either way; lanes outside `valid` are zero).
+#[cfg(target_arch = "x86_64")]
+struct Rows {
+    p: *const f64,
+    t: __m256i,
+    valid: __mmask8,
+    near: Near,
+}
+
+#[cfg(target_arch = "x86_64")]
+enum Near {
+    Two([__m512d; 2], __m256i),
+    Four([__m512d; 4], __m256i),
+    Far,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Rows {
+    /// # Safety
+    /// As the gathers: every valid lane's 3 i + 2 < 3 len; i0 ≤ il are its first and last records.
+    #[inline(always)]
+    unsafe fn new(p: *const f64, i0: usize, il: usize, len: usize, t: __m256i, valid: __mmask8) -> Rows {
+        let span = il.wrapping_sub(i0);
+        let at = p.add(3 * i0);
+        let rel = || _mm256_sub_epi32(t, _mm256_set1_epi32(3 * i0 as i32));
+        let near = if span <= 4 && 3 * i0 + 16 <= 3 * len {
+            Near::Two([_mm512_loadu_pd(at), _mm512_loadu_pd(at.add(8))], rel())
+        } else if span <= 9 && 3 * i0 + 32 <= 3 * len {
+            let l = |o: usize| _mm512_loadu_pd(at.add(o));
+            Near::Four([l(0), l(8), l(16), l(24)], rel())
+        } else {
+            Near::Far
+        };
+        Rows { p, t, valid, near }
+    }
+
+    #[inline(always)]
+    unsafe fn component(&self, q: usize) -> __m512d {
+        let idx = |rel: __m256i| _mm512_cvtepi32_epi64(_mm256_add_epi32(rel, _mm256_set1_epi32(q as i32)));
+        match self.near {
+            Near::Two([a, b], rel) => _mm512_maskz_permutex2var_pd(self.valid, a, idx(rel), b),
+            Near::Four([a, b, c, d], rel) => {
+                let i = idx(rel);
+                let (lo, hi) = (_mm512_permutex2var_pd(a, i, b), _mm512_permutex2var_pd(c, i, d));
+                let upper = _mm512_cmpge_epi64_mask(i, _mm512_set1_epi64(16));
+                _mm512_maskz_mov_pd(self.valid, _mm512_mask_blend_pd(upper, lo, hi))
+            }
+            Near::Far => _mm512_mask_i32gather_pd::<8>(_mm512_setzero_pd(), self.valid, self.t, self.p.add(q)),
+        }
+    }
+}
+
+#[cfg(all(test, target_arch = "x86_64"))]
+mod tests {
+    use super::*;
+
+    /// `Rows` gives what a masked gather gives, for every span (the two-load, four-load and
+    /// gather paths), lanes near both ends of the array and partial masks.
+    #[test]
+    fn rows_by_permute_equal_the_gather() {
+        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
+            return;
+        }
+        let len = 40;
+        let data: Vec<[f64; 3]> = (0..len).map(|i| [i as f64, 1000.0 + i as f64, -(i as f64) - 0.5]).collect();
+        let p = data.as_ptr() as *const f64;
+        let mut seed = 7u64;
+        for case in 0..3000 {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let span = (seed >> 33) as usize % 14;
+            let i0 = (seed >> 13) as usize % (len - span);
+            // Eight ascending rows in i0..=i0 + span, the first i0, the last valid one i0 + span.
+            let valid: u8 = if case % 3 == 0 { 0xff >> ((seed >> 50) % 8) } else { 0xff };
+            let nvalid = 8 - valid.leading_zeros() as usize;
+            let mut rows = [i0; 8];
+            for (q, r) in rows.iter_mut().enumerate().take(nvalid) {
+                *r = if nvalid == 1 { i0 } else { i0 + (span * q) / (nvalid - 1) };
+            }
+            let mask = if case % 5 == 0 { valid & (seed >> 40) as u8 } else { valid };
+            let t: [i32; 8] = rows.map(|r| 3 * r as i32);
+            // SAFETY: the features were checked; every lane's row is below len.
+            unsafe {
+                let tv = _mm256_loadu_si256(t.as_ptr() as *const __m256i);
+                let r = Rows::new(p, i0, rows[nvalid - 1], len, tv, mask);
+                for q in 0..3 {
+                    let got: [f64; 8] = std::mem::transmute(r.component(q));
+                    for lane in 0..8 {
+                        let want = if mask >> lane & 1 == 1 { data[rows[lane]][q] } else { 0.0 };
+                        assert_eq!(got[lane], want, "case {case}: span {span}, first row {i0}, lane {lane}, component {q}");
+                    }
+                }
+            }
+        }
     }
 }
