@@ -66,7 +66,8 @@ pub struct ContactForce {
     pub f: V3,
     /// n × F_t; the torque on each partner is its radius times this.
     pub c: V3,
-    /// |F_t|² − (μ F_n)², > 0 would break the Coulomb limit (diagnostics).
+    /// (|F_t|² − (μ F_n)²) / (μ F_n)², > 0 would break the Coulomb limit (diagnostics; relative,
+    /// so that round-off reads the same at every load).
     pub excess: f64,
 }
 
@@ -117,5 +118,5 @@ pub fn contact_force<const FRICTION: bool>(
     }
     *shear = s;
     f = [f[0] + ft[0], f[1] + ft[1], f[2] + ft[2]];
-    ContactForce { f, c: cross(n, ft), excess: dot(ft, ft) - lim * lim }
+    ContactForce { f, c: cross(n, ft), excess: (dot(ft, ft) - lim * lim) / (lim * lim).max(f64::MIN_POSITIVE) }
 }

@@ -1,5 +1,6 @@
-//! The batched pair kernel (fast path) evaluates exactly the scalar contact law of
-//! `contact::contact_force` (PHYSICS.md 2.2-2.3): same forces, torques and history, bit for bit.
+//! The batched pair kernel (fast path, single-precision lanes) evaluates the scalar contact law
+//! of `contact::contact_force` (PHYSICS.md 2.2-2.3, double precision): the same forces, torques
+//! and histories to ~1e-7 relative; its vector and portable variants agree bit for bit.
 
 use super::{test_case, with_damping};
 use crate::dem::contact::contact_force;
@@ -8,7 +9,7 @@ use crate::dem::DemParams;
 use rand::{Rng, SeedableRng};
 
 #[test]
-fn batched_pair_kernel_equals_the_scalar_contact_law() {
+fn batched_pair_kernel_matches_the_double_precision_contact_law() {
     // 40 pairs fill five vectors of 8; 37 leave three lanes of the last one to scratch.
     batch_against_scalar_law(40);
     batch_against_scalar_law(37);
@@ -28,7 +29,9 @@ fn batch_against_scalar_law(n: usize) {
     for l in 0..n {
         let dir = [u(1.0), u(1.0), u(1.0)];
         let len = (dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]).sqrt();
-        let dist = 2.0 * r * (1.0 - 0.01 * rng_frac(l));
+        // Overlaps up to 1% of d, and every third pair up to 1e-6 d (where δ = d − |r| would
+        // lose its digits to cancellation in single precision).
+        let dist = 2.0 * r * (1.0 - [0.01, 0.01, 1e-6][l % 3] * rng_frac(l));
         x.push([0.0, 0.0, 0.0]);
         x.push([dir[0] / len * dist, dir[1] / len * dist, dir[2] / len * dist]);
     }
@@ -70,6 +73,7 @@ fn batch_against_scalar_law(n: usize) {
         assert_eq!(m2, &maxima, "vector gather: maxima");
     }
     let (mut slid, mut max_delta, mut max_excess) = (0, 0.0f64, f64::NEG_INFINITY);
+    let mut worst = [0.0f64; 3];
     for l in 0..n {
         let (i, j) = (2 * l, 2 * l + 1);
         let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
@@ -80,14 +84,26 @@ fn batch_against_scalar_law(n: usize) {
         let ws = [r * (w[i][0] + w[j][0]), r * (w[i][1] + w[j][1]), r * (w[i][2] + w[j][2])];
         let mut s = shear0[l];
         let cf = contact_force::<true>(&p.pair, 2.0 * r - dist, nrm, vrel, ws, &mut s, p.dt);
-        assert_eq!([batch.f[0][l], batch.f[1][l], batch.f[2][l]], cf.f, "force of pair {l}");
-        assert_eq!([batch.c[0][l], batch.c[1][l], batch.c[2][l]], cf.c, "torque of pair {l}");
-        assert_eq!(shear[l], s, "history of pair {l}");
-        slid += (cf.excess > -1e-30) as usize;
+        // Relative to the vector's length (a component may be near zero).
+        let err = |a: [f64; 3], b: [f64; 3]| {
+            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt()
+        };
+        worst[0] = worst[0].max(err([batch.f[0][l], batch.f[1][l], batch.f[2][l]], cf.f));
+        worst[1] = worst[1].max(err([batch.c[0][l], batch.c[1][l], batch.c[2][l]], cf.c));
+        worst[2] = worst[2].max(err(shear[l], s));
+        slid += (cf.excess > -1e-9) as usize;
         max_delta = max_delta.max(2.0 * r - dist);
         max_excess = max_excess.max(cf.excess);
     }
-    assert_eq!(maxima, (max_delta, max_excess), "max overlap and Coulomb excess of the {n} pairs alone");
+    // Single precision carries ~6e-8 per operation. Seen: ≤ 4e-7 for the larger overlaps, ≤ 1.5e-6
+    // with the tiny ones, whose elastic and damping terms nearly cancel (the error stays ~1e-7
+    // of the terms).
+    for (what, e) in ["forces", "torques", "histories"].iter().zip(worst) {
+        assert!(e < 5e-6, "{what}: largest relative error {e:.2e} against the double-precision law");
+    }
+    assert!((maxima.0 - max_delta).abs() < 1e-6 * max_delta, "max overlap {} against {max_delta}", maxima.0);
+    assert!((maxima.1 - max_excess).abs() < 1e-5, "max Coulomb excess {} against {max_excess}", maxima.1);
     assert!(slid > 0 && slid < n, "both sticking and sliding pairs exercised ({slid} of {n} slid)");
 }
 
@@ -141,7 +157,7 @@ fn vector_pair_pass_equals_the_portable_one() {
     let (portable, vector) = (run(Kernels::Portable), run(Kernels::Best));
     let touching = portable.3.iter().filter(|&&t| t == 1).count();
     assert!(touching > 1000 && touching < portable.3.len(), "{touching} of {} entries touch", portable.3.len());
-    assert!(portable.1 > -1e-30, "some contacts slide (Coulomb excess {})", portable.1);
+    assert!(portable.1 > -1e-6, "some contacts slide (Coulomb excess {})", portable.1);
     assert_eq!(portable.0.to_bits(), vector.0.to_bits(), "largest overlap");
     assert_eq!(portable.1.to_bits(), vector.1.to_bits(), "largest Coulomb excess");
     let first_diff = |a: Vec<u64>, b: Vec<u64>| a.iter().zip(&b).position(|(x, y)| x != y);
