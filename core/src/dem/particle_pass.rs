@@ -14,8 +14,8 @@ use rayon::prelude::*;
 pub const BLOCK: usize = 256;
 
 /// Force and n × F_t sums of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices):
-/// the external force, then the chunk buffers in chunk order, then walls for the wall-list
-/// entries `widx`/`whist`.
+/// the external force (none when `ext` is empty), then the chunk buffers in chunk order, then
+/// walls for the wall-list entries `widx`/`whist`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn block_forces<const FR: bool>(
@@ -23,8 +23,13 @@ fn block_forces<const FR: bool>(
     whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
 ) {
     let hi = lo + out.len();
-    for (o, e) in out.iter_mut().zip(&ext[lo..hi]) {
-        *o = [e[0], e[1], e[2], 0.0, 0.0, 0.0];
+    if ext.is_empty() {
+        // A scene without gas skips the stream of zeros (3% of a step, docs/BENCHMARKS.md).
+        out.fill([0.0; 6]);
+    } else {
+        for (o, e) in out.iter_mut().zip(&ext[lo..hi]) {
+            *o = [e[0], e[1], e[2], 0.0, 0.0, 0.0];
+        }
     }
     for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
         let (s, t) = (lo.max(a), hi.min(e));

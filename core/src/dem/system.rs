@@ -29,6 +29,8 @@ pub struct DemSystem {
     /// Positions at the last Verlet-list build and at the last near-list refresh.
     x_build: Vec<V3>,
     x_near: Vec<V3>,
+    /// External forces; empty until a coupling sets them (a DEM-only scene reads none).
+    #[serde(default)]
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
     /// The Verlet list (cutoff `p.cutoff`; its history arrays are emptied once the near list is
@@ -76,7 +78,7 @@ impl DemSystem {
             ring: 0,
             x_build: Vec::new(),
             x_near: Vec::new(),
-            ext: vec![[0.0; 3]; n],
+            ext: Vec::new(),
             ids: (0..n as u32).collect(),
             outer: NeighborList::default(),
             near: NearList::default(),
@@ -105,6 +107,9 @@ impl DemSystem {
     }
     /// Per-particle extra force (drag, −V∇p) in the current order, held through the next step.
     pub fn external_forces_mut(&mut self) -> &mut [[f64; 3]] {
+        if self.ext.len() != self.x.len() {
+            self.ext = vec![[0.0; 3]; self.x.len()];
+        }
         &mut self.ext
     }
     pub fn positions(&self) -> &[[f64; 3]] {
@@ -371,7 +376,9 @@ impl DemSystem {
         self.x = perm(&self.x);
         self.v = perm(&self.v);
         self.w = perm(&self.w);
-        self.ext = perm(&self.ext);
+        if !self.ext.is_empty() {
+            self.ext = perm(&self.ext);
+        }
         self.past.permute(&order);
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();

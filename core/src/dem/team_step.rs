@@ -136,7 +136,7 @@ pub struct StepState<'a> {
 pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: StepState, x_ref: &[V3], ext: &[V3]) -> Stats {
     let StepState { x, v, w, past, walls, nl, sc } = s;
     let n = x.len();
-    assert!(v.len() == n && w.len() == n && x_ref.len() == n && ext.len() == n);
+    assert!(v.len() == n && w.len() == n && x_ref.len() == n && (ext.is_empty() || ext.len() == n));
     assert!(past.v.iter().chain(&past.a).chain(&past.alpha).all(|s| s.len() == n), "past derivatives");
     let (offsets, nbr) = (&nl.offsets[..], &nl.nbr[..]);
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
