@@ -9,28 +9,39 @@ use super::work_split::Sums;
 use super::walls::{wall_forces, WallList};
 use super::DemParams;
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 
 /// Particles per block of the particle pass.
 pub const BLOCK: usize = 256;
+
+/// `out` with every row written (the block's stack rows need no clearing pass first, which
+/// cost ~1% of a step).
+#[inline(always)]
+fn written<T: Copy>(out: &mut [MaybeUninit<T>], mut row: impl FnMut(usize) -> T) -> &mut [T] {
+    for (l, o) in out.iter_mut().enumerate() {
+        o.write(row(l));
+    }
+    // SAFETY: every element was written just above.
+    unsafe { &mut *(out as *mut [MaybeUninit<T>] as *mut [T]) }
+}
 
 /// Force and n × F_t sums of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices):
 /// the external force (none when `ext` is empty), then the chunk buffers in chunk order, then
 /// walls for the wall-list entries `widx`/`whist`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn block_forces<const FR: bool>(
+fn block_forces<'o, const FR: bool>(
     p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: Sums, widx: &[u32],
-    whist: &mut [[V3; 3]], out: &mut [Acc], st: &mut Stats,
-) {
+    whist: &mut [[V3; 3]], out: &'o mut [MaybeUninit<Acc>], st: &mut Stats,
+) -> &'o mut [Acc] {
     let hi = lo + out.len();
-    if ext.is_empty() {
-        // A scene without gas skips the stream of zeros (3% of a step, docs/BENCHMARKS.md).
-        out.fill([0.0; 6]);
+    // A scene without gas skips the stream of zeros (3% of a step, docs/BENCHMARKS.md).
+    let out = if ext.is_empty() {
+        written(out, |_| [0.0; 6])
     } else {
-        for (o, e) in out.iter_mut().zip(&ext[lo..hi]) {
-            *o = [e[0], e[1], e[2], 0.0, 0.0, 0.0];
-        }
-    }
+        let ext = &ext[lo..hi];
+        written(out, |l| [ext[l][0], ext[l][1], ext[l][2], 0.0, 0.0, 0.0])
+    };
     for (c, &[a, _, e]) in sc.bounds.iter().enumerate() {
         let (s, t) = (lo.max(a), hi.min(e));
         if s < t {
@@ -48,6 +59,7 @@ fn block_forces<const FR: bool>(
         st.overlap = st.overlap.max(ov);
         st.coulomb_excess = st.coulomb_excess.max(ex);
     }
+    out
 }
 
 /// a = F/m − g e_z − γ v and α = R (Σ n × F_t)/I − γ ω (gravity and the pour's extra damping γ)
@@ -93,7 +105,9 @@ pub fn accel_pass<const FR: bool>(
             let mut st = Stats::ZERO;
             let r = b * BLOCK..b * BLOCK + ob.len();
             let (v, w) = (&v[r.clone()], &w[r.clone()]);
-            block_forces::<FR>(p, r.start, &x[r], v, w, ext, sc, widx, whist, ob, &mut st);
+            // SAFETY: initialised rows seen as possibly uninitialised; block_forces writes them all.
+            let rows = unsafe { &mut *(ob as *mut [Acc] as *mut [MaybeUninit<Acc>]) };
+            let ob = block_forces::<FR>(p, r.start, &x[r], v, w, ext, sc, widx, whist, rows, &mut st);
             for ((o, &vi), &wi) in ob.iter_mut().zip(v).zip(w) {
                 let (a, alpha) = accel_of::<FR>(p, o, vi, wi);
                 *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
@@ -199,22 +213,19 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
     let len = x.len();
     let mut st = Stats::ZERO;
-    let mut acc = [[0.0; 6]; BLOCK];
-    let acc = &mut acc[..len];
-    block_forces::<FR>(p, lo, x, v, w, ext, sc, widx, whist, acc, &mut st);
+    let mut rows = [MaybeUninit::<Acc>::uninit(); BLOCK];
+    let acc = block_forces::<FR>(p, lo, x, v, w, ext, sc, widx, whist, &mut rows[..len], &mut st);
     // Accelerations straight into the flat arrays the update reads.
-    let mut a = [[0.0; 3]; BLOCK];
-    let mut al = [[0.0; 3]; BLOCK];
-    for ((o, (&vi, &wi)), (a, al)) in acc.iter().zip(v.iter().zip(w.iter())).zip(a[..len].iter_mut().zip(&mut al[..len])) {
-        (*a, *al) = accel_of::<FR>(p, o, vi, wi);
-    }
+    let (mut a, mut al) = ([MaybeUninit::<V3>::uninit(); BLOCK], [MaybeUninit::<V3>::uninit(); BLOCK]);
+    let a = written(&mut a[..len], |l| accel_of::<FR>(p, &acc[l], v[l], w[l]).0);
+    let al = written(&mut al[..len], |l| accel_of::<FR>(p, &acc[l], v[l], w[l]).1);
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();
     ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
-    ab_flat(hb, v.as_flattened_mut(), a[..len].as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
+    ab_flat(hb, v.as_flattened_mut(), a.as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
     if FR {
-        ab_flat(hb, w.as_flattened_mut(), al[..len].as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
+        ab_flat(hb, w.as_flattened_mut(), al.as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
     }
     // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).
