@@ -12,7 +12,7 @@ use super::pair_batch::{Batch, CAP};
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{scan8, LANES};
 use super::contact::{ContactLaw, V3};
-use super::neighbors::NeighborList;
+use super::neighbors::{Hist, NeighborList};
 pub use super::work_split::Scratch;
 use super::DemParams;
 use rayon::prelude::*;
@@ -126,7 +126,7 @@ pub(super) struct ChunkArgs<'a> {
     pub w: &'a [V3],
 }
 
-pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f")
@@ -146,13 +146,13 @@ pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [V3],
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
-unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     chunk_pairs::<FR, true>(c, sh, to, acc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     chunk_pairs::<FR, false>(c, sh, to, acc)
 }
 
@@ -160,7 +160,7 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mu
 /// added into `acc` (particles a..). Particles are read only in the window a..e, and the batch
 /// lanes hold indices into it (particle − a).
 #[inline(always)]
-fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
     let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
     acc.fill([0.0; 6]);
     let mut st = Stats::ZERO;
@@ -223,7 +223,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [V3], to: 
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
-    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [V3], base: usize,
+    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
     acc: &mut [Acc], st: &mut Stats,
 ) {
     let (ov, ex) = batch.evaluate::<FR, V>(law, r, h, v, w, sh, base);

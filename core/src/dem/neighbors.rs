@@ -10,6 +10,10 @@ use serde::{Deserialize, Serialize};
 /// Particles per work block of the list build (fixed, so results do not depend on threads).
 const BLOCK: usize = 256;
 
+/// A contact history ξ as stored: single precision, what the pair law (`pair_batch::lanes`)
+/// computes it in, so storing it so loses nothing and halves the bytes the pair pass streams.
+pub type Hist = [f32; 3];
+
 /// Half neighbour list in CSR form.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct NeighborList {
@@ -17,7 +21,7 @@ pub struct NeighborList {
     pub offsets: Vec<u32>,
     pub nbr: Vec<u32>,
     /// Tangential displacement ξ of each listed pair (oriented i → j); live only where `touch`.
-    pub shear: Vec<[f64; 3]>,
+    pub shear: Vec<Hist>,
     /// 1 when the pair touched in the last force evaluation (its history is live), else 0.
     pub touch: Vec<u8>,
 }
@@ -197,7 +201,7 @@ impl NeighborList {
         for i in 0..n {
             for k in self.offsets[i] as usize..self.offsets[i + 1] as usize {
                 let (a, b) = (new_ids[i], new_ids[self.nbr[k] as usize]);
-                let (lo, hi, sign) = if a < b { (a, b, 1.0) } else { (b, a, -1.0) };
+                let (lo, hi, sign) = if a < b { (a, b, 1.0f32) } else { (b, a, -1.0) };
                 let row = &map[count[lo as usize] as usize..count[lo as usize + 1] as usize];
                 if let Some(&(_, s)) = row.iter().find(|e| e.0 == hi) {
                     self.shear[k] = [sign * s[0], sign * s[1], sign * s[2]];

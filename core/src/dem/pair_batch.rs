@@ -9,6 +9,7 @@
 //! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
 use super::contact::{ContactLaw, V3};
+use super::neighbors::Hist;
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{gather8, LANES};
 
@@ -84,7 +85,7 @@ impl Batch {
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn evaluate<const FR: bool, const V: bool>(
-        &mut self, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [V3], base: usize,
+        &mut self, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [Hist], base: usize,
     ) -> (f64, f64) {
         let m = self.m.min(CAP);
         let n = v.len();
@@ -115,7 +116,7 @@ impl Batch {
                 let live = self.was[l] != 0;
                 for q in 0..3 {
                     self.ws[q][l] = r * (wi[q] + wj[q]);
-                    self.s[q][l] = if live { s[q] } else { 0.0 };
+                    self.s[q][l] = if live { s[q] as f64 } else { 0.0 };
                 }
             }
         }
@@ -129,7 +130,8 @@ impl Batch {
         }
         let max_excess = lane_max(&self.excess[..m], f64::NEG_INFINITY);
         for l in 0..m {
-            shear[self.k[l] as usize - base] = [self.s[0][l], self.s[1][l], self.s[2][l]];
+            // Exact: the law computed these in single precision.
+            shear[self.k[l] as usize - base] = [self.s[0][l] as f32, self.s[1][l] as f32, self.s[2][l] as f32];
         }
         (max_delta, max_excess)
     }

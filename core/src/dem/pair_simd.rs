@@ -13,6 +13,7 @@
 use std::arch::x86_64::*;
 
 use super::contact::V3;
+use super::neighbors::Hist;
 use super::pair_batch::{Batch, CAP};
 
 /// Lanes this step can add to a batch: a batch with more than `CAP - LANES` filled is flushed
@@ -85,7 +86,7 @@ pub unsafe fn scan8<const FR: bool>(
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn gather8<const FR: bool>(
-    batch: &mut Batch, l: usize, valid: __mmask8, r: f64, v: &[V3], w: &[V3], shear: &[V3], base: usize,
+    batch: &mut Batch, l: usize, valid: __mmask8, r: f64, v: &[V3], w: &[V3], shear: &[Hist], base: usize,
 ) {
     debug_assert!(l + LANES <= CAP);
     let three = |a: __m256i| _mm256_add_epi32(_mm256_add_epi32(a, a), a);
@@ -109,7 +110,7 @@ pub unsafe fn gather8<const FR: bool>(
     if !FR {
         return;
     }
-    let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f64, _mm512_set1_pd(r));
+    let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f32, _mm512_set1_pd(r));
     let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
     // k < base wraps to a large unsigned value, so one compare checks both ends.
     assert!(below(kk, shear.len()) & valid == valid, "history slot beyond the chunk");
@@ -118,7 +119,7 @@ pub unsafe fn gather8<const FR: bool>(
     let live = valid & _pext_u64((batch.was.as_ptr().add(l) as *const u64).read_unaligned(), BYTES) as __mmask8;
     let wrows = Rows::new(wp, i0, il, w.len(), ti, valid);
     let (k0, kl) = (*batch.k.get_unchecked(l) as usize - base, *batch.k.get_unchecked(last) as usize - base);
-    let slots = Rows::new(sp, k0, kl, shear.len(), tk, live);
+    let slots = Slots::new(sp, k0, kl, shear.len(), tk, live);
     for q in 0..3 {
         let wi = wrows.component(q);
         let wj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, wp.add(q));
@@ -180,6 +181,46 @@ impl Rows {
             }
             Near::Far => _mm512_mask_i32gather_pd::<8>(_mm512_setzero_pd(), self.valid, self.t, self.p.add(q)),
         }
+    }
+}
+
+/// Component q of eight lanes' histories (single precision, a `Hist` array at `p` of `len`
+/// slots, lanes `valid`, offsets `t` = 3 k, ascending, first lane k0, last valid lane kl), in
+/// double: from two vector loads and a permute when the lanes span at most ten slots, else a
+/// gather (the same values either way; lanes outside `valid` are zero).
+#[cfg(target_arch = "x86_64")]
+struct Slots {
+    p: *const f32,
+    t: __m256i,
+    valid: __mmask8,
+    near: Option<([__m512; 2], __m256i)>,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl Slots {
+    /// # Safety
+    /// As the gathers: every valid lane's 3 k + 2 < 3 len; k0 ≤ kl are its first and last slots.
+    #[inline(always)]
+    unsafe fn new(p: *const f32, k0: usize, kl: usize, len: usize, t: __m256i, valid: __mmask8) -> Slots {
+        let near = if kl.wrapping_sub(k0) <= 9 && 3 * k0 + 32 <= 3 * len {
+            let at = p.add(3 * k0);
+            Some(([_mm512_loadu_ps(at), _mm512_loadu_ps(at.add(16))], _mm256_sub_epi32(t, _mm256_set1_epi32(3 * k0 as i32))))
+        } else {
+            None
+        };
+        Slots { p, t, valid, near }
+    }
+
+    #[inline(always)]
+    unsafe fn component(&self, q: usize) -> __m512d {
+        let got = match self.near {
+            Some(([a, b], rel)) => {
+                let idx = _mm512_zextsi256_si512(_mm256_add_epi32(rel, _mm256_set1_epi32(q as i32)));
+                _mm512_castps512_ps256(_mm512_permutex2var_ps(a, idx, b))
+            }
+            None => _mm256_mmask_i32gather_ps::<4>(_mm256_setzero_ps(), self.valid, self.t, self.p.add(q)),
+        };
+        _mm512_maskz_cvtps_pd(self.valid, got)
     }
 }
 

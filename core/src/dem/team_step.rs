@@ -10,7 +10,7 @@
 
 use super::contact::V3;
 use super::forces::{chunk_pairs_dispatch, Acc, ChunkArgs, Past, Scratch, Stats};
-use super::neighbors::NeighborList;
+use super::neighbors::{Hist, NeighborList};
 use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
 use super::steal_ranges::StealRanges;
 use super::walls::WallList;
@@ -224,7 +224,7 @@ struct Shared {
     w: Raw<V3>,
     past: [[Raw<V3>; 2]; 3],
     whist: Raw<[V3; 3]>,
-    shear: Raw<V3>,
+    shear: Raw<Hist>,
     touch: Raw<u8>,
     acc: Raw<Acc>,
 }

@@ -19,8 +19,9 @@ use std::path::Path;
 
 /// First bytes of a checkpoint, then the format number (u32, little-endian), then the state.
 const CHECKPOINT_MAGIC: &[u8; 8] = b"FLUIDBED";
-/// Bumped whenever the serialised state changes shape (format 2: the DEM's near list).
-const CHECKPOINT_FORMAT: u32 = 2;
+/// Bumped whenever the serialised state changes shape (format 2: the DEM's near list; 3: its
+/// contact histories in single precision).
+const CHECKPOINT_FORMAT: u32 = 3;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimError {

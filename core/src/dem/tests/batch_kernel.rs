@@ -37,7 +37,7 @@ fn batch_against_scalar_law(n: usize) {
     }
     let v: Vec<[f64; 3]> = (0..2 * n).map(|_| [u(1.0), u(1.0), u(1.0)]).collect();
     let w: Vec<[f64; 3]> = (0..2 * n).map(|_| [u(500.0), u(500.0), u(500.0)]).collect();
-    let shear0: Vec<[f64; 3]> = (0..n).map(|_| [u(1e-6), u(1e-6), u(1e-6)]).collect();
+    let shear0: Vec<[f32; 3]> = (0..n).map(|_| [u(1e-6) as f32, u(1e-6) as f32, u(1e-6) as f32]).collect();
     // Lane l holds the pair (2l, 2l + 1).
     let filled = || {
         let mut b = Batch::new();
@@ -82,7 +82,7 @@ fn batch_against_scalar_law(n: usize) {
         let nrm = [dx[0] * inv, dx[1] * inv, dx[2] * inv];
         let vrel = [v[i][0] - v[j][0], v[i][1] - v[j][1], v[i][2] - v[j][2]];
         let ws = [r * (w[i][0] + w[j][0]), r * (w[i][1] + w[j][1]), r * (w[i][2] + w[j][2])];
-        let mut s = shear0[l];
+        let mut s = shear0[l].map(f64::from);
         let cf = contact_force::<true>(&p.pair, 2.0 * r - dist, nrm, vrel, ws, &mut s, p.dt);
         // Relative to the vector's length (a component may be near zero).
         let err = |a: [f64; 3], b: [f64; 3]| {
@@ -91,7 +91,7 @@ fn batch_against_scalar_law(n: usize) {
         };
         worst[0] = worst[0].max(err([batch.f[0][l], batch.f[1][l], batch.f[2][l]], cf.f));
         worst[1] = worst[1].max(err([batch.c[0][l], batch.c[1][l], batch.c[2][l]], cf.c));
-        worst[2] = worst[2].max(err(shear[l], s));
+        worst[2] = worst[2].max(err(shear[l].map(f64::from), s));
         slid += (cf.excess > -1e-9) as usize;
         max_delta = max_delta.max(2.0 * r - dist);
         max_excess = max_excess.max(cf.excess);
@@ -144,7 +144,7 @@ fn vector_pair_pass_equals_the_portable_one() {
     }
     // Stale histories behind flags that say "not live" must be ignored: random both.
     for (s, t) in sys.near.list.shear.iter_mut().zip(sys.near.list.touch.iter_mut()) {
-        *s = [1e-6 * rng.gen::<f64>(), -1e-6 * rng.gen::<f64>(), 1e-7];
+        *s = [1e-6 * rng.gen::<f32>(), -1e-6 * rng.gen::<f32>(), 1e-7];
         *t = rng.gen::<bool>() as u8;
     }
     let p = sys.p.clone();
@@ -165,6 +165,6 @@ fn vector_pair_pass_equals_the_portable_one() {
     assert_eq!(first_diff(flags(&portable.3), flags(&vector.3)), None, "contact flags");
     let bits = |a: &[[f64; 6]]| a.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
     assert_eq!(first_diff(bits(&portable.2), bits(&vector.2)), None, "forces and torques (first differing value)");
-    let bits3 = |a: &[[f64; 3]]| a.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    let bits3 = |a: &[[f32; 3]]| a.iter().flatten().map(|f| f.to_bits() as u64).collect::<Vec<_>>();
     assert_eq!(first_diff(bits3(&portable.4), bits3(&vector.4)), None, "histories (first differing value)");
 }

@@ -108,7 +108,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     }
     for (e, &k) in s.near.src.iter().enumerate() {
         assert_eq!(near.touch[e], outer.touch[k as usize]);
-        assert!(near.shear[e].map(f64::to_bits) == outer.shear[k as usize].map(f64::to_bits), "history of entry {k}");
+        assert!(near.shear[e].map(f32::to_bits) == outer.shear[k as usize].map(f32::to_bits), "history of entry {k}");
     }
     // A refresh (with a gap of zero, so only touching or live entries stay) carries every live
     // history of the old near list to the same pair, bit for bit.
@@ -120,7 +120,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
         let o = old[&k];
         assert_eq!(again.list.nbr[e], s.near.list.nbr[o]);
         assert_eq!(again.list.touch[e], s.near.list.touch[o]);
-        assert!(again.list.shear[e].map(f64::to_bits) == s.near.list.shear[o].map(f64::to_bits), "history of entry {k}");
+        assert!(again.list.shear[e].map(f32::to_bits) == s.near.list.shear[o].map(f32::to_bits), "history of entry {k}");
         live += again.list.touch[e] as usize;
     }
     assert_eq!(live, s.near.list.touch.iter().filter(|&&t| t == 1).count(), "a live history was dropped");
