@@ -228,16 +228,17 @@ impl Slots {
 mod tests {
     use super::*;
 
-    /// `Rows` gives what a masked gather gives, for every span (the two-load, four-load and
-    /// gather paths), lanes near both ends of the array and partial masks.
+    /// `Rows` and `Slots` give what a masked gather gives, for every span (the two-load,
+    /// four-load and gather paths), lanes near both ends of the array and partial masks.
     #[test]
-    fn rows_by_permute_equal_the_gather() {
+    fn rows_and_slots_by_permute_equal_the_gather() {
         if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
             return;
         }
         let len = 40;
         let data: Vec<[f64; 3]> = (0..len).map(|i| [i as f64, 1000.0 + i as f64, -(i as f64) - 0.5]).collect();
         let p = data.as_ptr() as *const f64;
+        let hist: Vec<[f32; 3]> = data.iter().map(|d| d.map(|c| c as f32)).collect();
         let mut seed = 7u64;
         for case in 0..3000 {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -256,11 +257,14 @@ mod tests {
             unsafe {
                 let tv = _mm256_loadu_si256(t.as_ptr() as *const __m256i);
                 let r = Rows::new(p, i0, rows[nvalid - 1], len, tv, mask);
+                let s = Slots::new(hist.as_ptr() as *const f32, i0, rows[nvalid - 1], len, tv, mask);
                 for q in 0..3 {
                     let got: [f64; 8] = std::mem::transmute(r.component(q));
+                    let got_hist: [f64; 8] = std::mem::transmute(s.component(q));
                     for lane in 0..8 {
                         let want = if mask >> lane & 1 == 1 { data[rows[lane]][q] } else { 0.0 };
                         assert_eq!(got[lane], want, "case {case}: span {span}, first row {i0}, lane {lane}, component {q}");
+                        assert_eq!(got_hist[lane], want, "histories: case {case}, span {span}, lane {lane}, component {q}");
                     }
                 }
             }
