@@ -11,7 +11,7 @@
 use super::contact::{ContactLaw, V3};
 use super::neighbors::Hist;
 #[cfg(target_arch = "x86_64")]
-use super::pair_simd::{gather8, LANES};
+use super::pair_simd::{gather8, write_back8, LANES};
 
 /// Pairs per batch.
 pub const CAP: usize = 64;
@@ -129,7 +129,17 @@ impl Batch {
             *e /= l2.max(f64::MIN_POSITIVE);
         }
         let max_excess = lane_max(&self.excess[..m], f64::NEG_INFINITY);
-        for l in 0..m {
+        let mut l0 = 0;
+        #[cfg(target_arch = "x86_64")]
+        if V {
+            for l in (0..m).step_by(LANES) {
+                let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
+                // SAFETY: as for gather8 above (the same lanes); write_back8 checks the slots.
+                unsafe { write_back8(self, l, valid, shear, base) };
+            }
+            l0 = m;
+        }
+        for l in l0..m {
             // Exact: the law computed these in single precision.
             shear[self.k[l] as usize - base] = [self.s[0][l] as f32, self.s[1][l] as f32, self.s[2][l] as f32];
         }

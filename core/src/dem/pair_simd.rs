@@ -3,7 +3,8 @@
 //! - `scan8`: gather both positions of eight list entries, r² < (2R)², and compress the
 //!   touching ones into the next batch lanes (the scalar scan is in `forces`);
 //! - `gather8`: the velocities, spins and live histories of eight batch lanes (the scalar
-//!   gather is in `Batch::evaluate`).
+//!   gather is in `Batch::evaluate`);
+//! - `write_back8`: the lanes' new histories back into their slots (scalar: `Batch::evaluate`).
 //!
 //! The row side of eight entries or lanes (x_i, v_i, ω_i) and their history slots are ascending
 //! and close together, so `Rows` loads them as two or four whole vectors and permutes instead
@@ -126,6 +127,27 @@ pub unsafe fn gather8<const FR: bool>(
         _mm512_storeu_pd(batch.ws[q].as_mut_ptr().add(l), _mm512_mul_pd(rr, _mm512_add_pd(wi, wj)));
         let sq = slots.component(q);
         _mm512_storeu_pd(batch.s[q].as_mut_ptr().add(l), sq);
+    }
+}
+
+/// The histories of lanes l..l+8 (those in `valid`) back into `shear[k − base]`, by three
+/// vector scatters (the slots are distinct; the values are exact in single precision). Panics
+/// unless every valid lane has base ≤ k < base + shear.len().
+///
+/// # Safety
+/// The CPU has avx512f and avx512vl; l + 8 ≤ CAP; shear.len() ≤ i32::MAX / 3.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub unsafe fn write_back8(batch: &Batch, l: usize, valid: __mmask8, shear: &mut [Hist], base: usize) {
+    debug_assert!(l + LANES <= CAP);
+    let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let inside = _mm256_cmplt_epu32_mask(kk, _mm256_set1_epi32(shear.len() as i32));
+    assert!(inside & valid == valid, "history slot beyond the chunk");
+    let tk = _mm256_add_epi32(_mm256_add_epi32(kk, kk), kk);
+    let sp = shear.as_mut_ptr() as *mut f32;
+    for q in 0..3 {
+        let s = _mm512_cvtpd_ps(_mm512_loadu_pd(batch.s[q].as_ptr().add(l)));
+        _mm256_mask_i32scatter_ps::<4>(sp.add(q), valid, tk, s);
     }
 }
 
