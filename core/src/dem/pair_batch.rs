@@ -173,10 +173,10 @@ impl Default for Box<Batch> {
 /// The contact law over lanes 0..m, no branches (the operations of `contact_force`), in single
 /// precision from double-precision inputs: the overlap comes from d² − r² taken in double,
 /// δ = (d² − r²)/(d + |r|), so it keeps ~1e-7 relative accuracy however small it is, and every
-/// force, torque and history is within ~1e-6 of the double law (test `batch_kernel`). Sixteen
-/// lanes per AVX-512 vector instead of eight: 6–12% faster steps (docs/BENCHMARKS.md, "The contact
-/// law in single precision"). All kernel variants do the same IEEE operations (no FMA), so they
-/// give the same bits.
+/// force, torque and history is within ~1.5e-6 of the double law (test `batch_kernel`). Sixteen
+/// lanes per AVX-512 vector instead of eight: 4–11% faster steps (docs/BENCHMARKS.md, "Single
+/// precision where it costs nothing that matters"). All kernel variants do the same IEEE
+/// operations (no FMA), so they give the same bits.
 #[inline(always)]
 fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // Whole vectors of 16: the lanes past b.m hold scratch (zeros or older pairs) whose results

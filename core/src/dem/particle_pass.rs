@@ -35,7 +35,7 @@ fn block_forces<'o, const FR: bool>(
     whist: &mut [[V3; 3]], out: &'o mut [MaybeUninit<Acc>], st: &mut Stats,
 ) -> &'o mut [Acc] {
     let hi = lo + out.len();
-    // A scene without gas skips the stream of zeros (3% of a step, docs/BENCHMARKS.md).
+    // A scene without gas skips the stream of zeros (1–5% of a step, docs/BENCHMARKS.md).
     let out = if ext.is_empty() {
         written(out, |_| [0.0; 6])
     } else {
@@ -62,15 +62,19 @@ fn block_forces<'o, const FR: bool>(
     out
 }
 
-/// a = F/m − g e_z − γ v and α = R (Σ n × F_t)/I − γ ω (gravity and the pour's extra damping γ)
-/// of a particle with sums `o`, velocity `vi` and spin `wi`.
+/// a = F/m − g e_z − γ v of a particle with sums `o` and velocity `vi` (gravity and the pour's
+/// extra damping γ).
 #[inline(always)]
-fn accel_of<const FR: bool>(p: &DemParams, o: &Acc, vi: V3, wi: V3) -> (V3, V3) {
+fn accel_of(p: &DemParams, o: &Acc, vi: V3) -> V3 {
     let (im, g, gz) = (1.0 / p.mass, p.extra_damping, p.gravity);
-    let ii = p.radius / p.inertia;
-    let a = [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]];
-    let alpha = if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] };
-    (a, alpha)
+    [o[0] * im - g * vi[0], o[1] * im - g * vi[1], o[2] * im - gz - g * vi[2]]
+}
+
+/// α = R (Σ n × F_t)/I − γ ω of a particle with sums `o` and spin `wi` (zero without friction).
+#[inline(always)]
+fn alpha_of<const FR: bool>(p: &DemParams, o: &Acc, wi: V3) -> V3 {
+    let (ii, g) = (p.radius / p.inertia, p.extra_damping);
+    if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] }
 }
 
 /// The wall-list entries (sorted by particle) of block b of n particles.
@@ -109,7 +113,7 @@ pub fn accel_pass<const FR: bool>(
             let rows = unsafe { &mut *(ob as *mut [Acc] as *mut [MaybeUninit<Acc>]) };
             let ob = block_forces::<FR>(p, r.start, &x[r], v, w, ext, sc, widx, whist, rows, &mut st);
             for ((o, &vi), &wi) in ob.iter_mut().zip(v).zip(w) {
-                let (a, alpha) = accel_of::<FR>(p, o, vi, wi);
+                let (a, alpha) = (accel_of(p, o, vi), alpha_of::<FR>(p, o, wi));
                 *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
             }
             st
@@ -217,8 +221,8 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let acc = block_forces::<FR>(p, lo, x, v, w, ext, sc, widx, whist, &mut rows[..len], &mut st);
     // Accelerations straight into the flat arrays the update reads.
     let (mut a, mut al) = ([MaybeUninit::<V3>::uninit(); BLOCK], [MaybeUninit::<V3>::uninit(); BLOCK]);
-    let a = written(&mut a[..len], |l| accel_of::<FR>(p, &acc[l], v[l], w[l]).0);
-    let al = written(&mut al[..len], |l| accel_of::<FR>(p, &acc[l], v[l], w[l]).1);
+    let a = written(&mut a[..len], |l| accel_of(p, &acc[l], v[l]));
+    let al = written(&mut al[..len], |l| alpha_of::<FR>(p, &acc[l], w[l]));
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();

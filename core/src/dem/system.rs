@@ -30,7 +30,6 @@ pub struct DemSystem {
     x_build: Vec<V3>,
     x_near: Vec<V3>,
     /// External forces; empty until a coupling sets them (a DEM-only scene reads none).
-    #[serde(default)]
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
     /// The Verlet list (cutoff `p.cutoff`; its history arrays are emptied once the near list is
