@@ -206,7 +206,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
             batch.was[m] = *t;
             *t = touching as u8;
         }
-        batch.set(m, k, i, j, dx, r2);
+        batch.set(m, k, i, j, dx, r2, d2);
         m += touching as usize;
         if m == CAP {
             batch.m = m;
@@ -231,8 +231,8 @@ fn flush<const FR: bool, const V: bool>(
     st.coulomb_excess = st.coulomb_excess.max(ex);
     for l in 0..batch.m {
         let (ii, jj) = (batch.i[l] as usize, batch.j[l] as usize);
-        let f = [batch.f[0][l], batch.f[1][l], batch.f[2][l]];
-        let c = if FR { [batch.c[0][l], batch.c[1][l], batch.c[2][l]] } else { [0.0; 3] };
+        let f = [batch.f[0][l] as f64, batch.f[1][l] as f64, batch.f[2][l] as f64];
+        let c = if FR { [batch.c[0][l] as f64, batch.c[1][l] as f64, batch.c[2][l] as f64] } else { [0.0; 3] };
         // F on i, −F on j; both partners feel R n × F_t (contact points ±R n, forces ±F_t).
         let on_i = [f[0], f[1], f[2], c[0], c[1], c[2]];
         let on_j = [-f[0], -f[1], -f[2], c[0], c[1], c[2]];

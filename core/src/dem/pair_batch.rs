@@ -1,6 +1,8 @@
 //! The particle-particle contact law of `contact::contact_force`, evaluated for a batch of
 //! touching pairs at a time (PHYSICS.md 2.2-2.3), in single precision from double-precision
-//! positions, velocities and histories (see `lanes`; forces are summed in double).
+//! positions, velocities and histories (see `lanes`; forces are summed in double). The lanes
+//! hold single-precision values only (each rounded once from the double it is formed in), so
+//! the lane loop is all single precision and runs sixteen lanes per AVX-512 vector.
 //!
 //! Three phases: a scalar gather (velocities, spins and histories of the lanes' particles into
 //! lane arrays), a branch-free lane loop over independent contacts that the compiler turns into
@@ -16,7 +18,7 @@ use super::pair_simd::{gather8, write_back8, LANES};
 /// Pairs per batch.
 pub const CAP: usize = 64;
 
-type Lanes = [f64; CAP];
+type Lanes = [f32; CAP];
 
 /// Touching pairs waiting for evaluation (structure of arrays over lanes).
 #[repr(C, align(64))]
@@ -26,9 +28,10 @@ pub struct Batch {
     pub k: [u32; CAP],
     pub i: [u32; CAP],
     pub j: [u32; CAP],
-    /// x_j − x_i and its squared length.
+    /// x_j − x_i, its squared length r² and (2R)² − r² (formed in double, then rounded).
     pub dx: [Lanes; 3],
     pub r2: Lanes,
+    pub gap2: Lanes,
     /// 1 when the pair touched in the previous step (its history is live), else 0.
     pub was: [u8; CAP],
     // Gathered inputs and per-lane diagnostics.
@@ -54,6 +57,7 @@ impl Batch {
             j: [0; CAP],
             dx: [z; 3],
             r2: z,
+            gap2: z,
             was: [1; CAP],
             vrel: [z; 3],
             ws: [z; 3],
@@ -66,17 +70,20 @@ impl Batch {
         })
     }
 
-    /// Fill lane `l` < CAP (the caller counts lanes and sets `m` before `evaluate`).
+    /// Fill lane `l` < CAP with the pair x_j − x_i = `dx`, r² = `r2`, contact at r² = `d2`
+    /// (the caller counts lanes and sets `m` before `evaluate`).
     #[inline(always)]
-    pub fn set(&mut self, l: usize, k: usize, i: usize, j: usize, dx: V3, r2: f64) {
+    #[allow(clippy::too_many_arguments)]
+    pub fn set(&mut self, l: usize, k: usize, i: usize, j: usize, dx: V3, r2: f64, d2: f64) {
         let l = l % CAP; // a no-op for l < CAP that lets the compiler drop the bounds checks
         self.k[l] = k as u32;
         self.i[l] = i as u32;
         self.j[l] = j as u32;
-        self.dx[0][l] = dx[0];
-        self.dx[1][l] = dx[1];
-        self.dx[2][l] = dx[2];
-        self.r2[l] = r2;
+        self.dx[0][l] = dx[0] as f32;
+        self.dx[1][l] = dx[1] as f32;
+        self.dx[2][l] = dx[2] as f32;
+        self.r2[l] = r2 as f32;
+        self.gap2[l] = (d2 - r2) as f32;
     }
 
     /// Evaluate every lane: fills `f` (and `c`, and the history `shear[k − base]` when FR; a lane
@@ -108,27 +115,25 @@ impl Batch {
             // SAFETY: checked just above (one compare for four loads).
             let (vi, vj) = unsafe { (*v.get_unchecked(i), *v.get_unchecked(j)) };
             for q in 0..3 {
-                self.vrel[q][l] = vi[q] - vj[q];
+                self.vrel[q][l] = (vi[q] - vj[q]) as f32;
             }
             if FR {
                 let (wi, wj) = unsafe { (*w.get_unchecked(i), *w.get_unchecked(j)) };
                 let s = shear[self.k[l] as usize - base];
                 let live = self.was[l] != 0;
                 for q in 0..3 {
-                    self.ws[q][l] = r * (wi[q] + wj[q]);
-                    self.s[q][l] = if live { s[q] as f64 } else { 0.0 };
+                    self.ws[q][l] = (r * (wi[q] + wj[q])) as f32;
+                    self.s[q][l] = if live { s[q] } else { 0.0 };
                 }
             }
         }
         lanes::<FR>(self, law, 2.0 * r, h);
-        let max_delta = lane_max(&self.delta[..m], 0.0);
+        let max_delta = lane_max(m, 0.0f32, |l| self.delta[l]) as f64;
         if !FR {
             return (max_delta, f64::NEG_INFINITY);
         }
-        for (e, &l2) in self.excess[..m].iter_mut().zip(&self.lim2[..m]) {
-            *e /= l2.max(f64::MIN_POSITIVE);
-        }
-        let max_excess = lane_max(&self.excess[..m], f64::NEG_INFINITY);
+        let (ex, l2) = (&self.excess[..m], &self.lim2[..m]);
+        let max_excess = lane_max(m, f64::NEG_INFINITY, |l| ex[l] as f64 / (l2[l] as f64).max(f64::MIN_POSITIVE));
         let mut l0 = 0;
         #[cfg(target_arch = "x86_64")]
         if V {
@@ -140,25 +145,25 @@ impl Batch {
             l0 = m;
         }
         for l in l0..m {
-            // Exact: the law computed these in single precision.
-            shear[self.k[l] as usize - base] = [self.s[0][l] as f32, self.s[1][l] as f32, self.s[2][l] as f32];
+            shear[self.k[l] as usize - base] = [self.s[0][l], self.s[1][l], self.s[2][l]];
         }
         (max_delta, max_excess)
     }
 }
 
-/// max(start, values…) with eight independent partial maxima (a vector max, not a serial chain;
-/// max is exact, so the grouping does not change the result).
+/// max(start, value(0), …, value(n − 1)) with eight independent partial maxima (a vector max,
+/// not a serial chain; max is exact, so the grouping does not change the result).
 #[inline(always)]
-fn lane_max(values: &[f64], start: f64) -> f64 {
+fn lane_max<T: Copy + PartialOrd>(n: usize, start: T, value: impl Fn(usize) -> T) -> T {
     let mut part = [start; 8];
-    let mut groups = values.chunks_exact(8);
-    for g in &mut groups {
+    for g in 0..n / 8 {
         for q in 0..8 {
-            part[q] = if g[q] > part[q] { g[q] } else { part[q] };
+            let x = value(8 * g + q);
+            part[q] = if x > part[q] { x } else { part[q] };
         }
     }
-    for &x in groups.remainder() {
+    for l in n / 8 * 8..n {
+        let x = value(l);
         part[0] = if x > part[0] { x } else { part[0] };
     }
     part.iter().fold(start, |a, &b| if b > a { b } else { a })
@@ -173,10 +178,12 @@ impl Default for Box<Batch> {
 /// The contact law over lanes 0..m, no branches (the operations of `contact_force`), in single
 /// precision from double-precision inputs: the overlap comes from d² − r² taken in double,
 /// δ = (d² − r²)/(d + |r|), so it keeps ~1e-7 relative accuracy however small it is, and every
-/// force, torque and history is within ~1.5e-6 of the double law (test `batch_kernel`). Sixteen
-/// lanes per AVX-512 vector instead of eight: 4–11% faster steps (docs/BENCHMARKS.md, "Single
-/// precision where it costs nothing that matters"). All kernel variants do the same IEEE
-/// operations (no FMA), so they give the same bits.
+/// force, torque and history is within ~1.5e-6 of the double law (test `batch_kernel`); 4–11%
+/// faster steps (docs/BENCHMARKS.md, "Single precision where it costs nothing that matters").
+/// Every array the loop reads or writes is single precision: with double arrays in the loop the
+/// compiler sized its vectors by them (eight lanes per step); now it takes sixteen ("Sixteen
+/// lanes, not eight"). All kernel variants do the same IEEE operations (no FMA), so they give
+/// the same bits.
 #[inline(always)]
 fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // Whole vectors of 16: the lanes past b.m hold scratch (zeros or older pairs) whose results
@@ -184,28 +191,27 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // several times the cost of a vector lane (docs/BENCHMARKS.md, "The lane loop's scalar tail").
     let m = ((b.m.min(CAP) + 15) & !15).min(CAP);
     let (kn, dn, ktl, dtl, mu, nt) = (law.kn as f32, law.dn as f32, law.kt as f32, law.dt as f32, law.mu as f32, law.no_tension);
-    let (dd, d1, h) = (d * d, d as f32, h as f32);
+    let (d1, h) = (d as f32, h as f32);
     for l in 0..m {
-        let r2 = b.r2[l];
-        let dist = (r2 as f32).sqrt();
+        let dist = b.r2[l].sqrt();
         let inv = 1.0 / dist;
-        let n = [b.dx[0][l] as f32 * inv, b.dx[1][l] as f32 * inv, b.dx[2][l] as f32 * inv];
-        let delta = (dd - r2) as f32 / (d1 + dist);
-        b.delta[l] = delta as f64;
+        let n = [b.dx[0][l] * inv, b.dx[1][l] * inv, b.dx[2][l] * inv];
+        let delta = b.gap2[l] / (d1 + dist);
+        b.delta[l] = delta;
         let sd = delta.sqrt();
         let qd = sd.sqrt(); // δ^{1/4} without powf
-        let vr = [b.vrel[0][l] as f32, b.vrel[1][l] as f32, b.vrel[2][l] as f32];
+        let vr = [b.vrel[0][l], b.vrel[1][l], b.vrel[2][l]];
         let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
         // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt (PHYSICS.md 2.2)
         let fnorm = kn * delta * sd + dn * qd * vn;
         let fnorm = if nt { fnorm.max(0.0) } else { fnorm };
         let mut f = [-fnorm * n[0], -fnorm * n[1], -fnorm * n[2]];
         if FR {
-            let ws = [b.ws[0][l] as f32, b.ws[1][l] as f32, b.ws[2][l] as f32];
+            let ws = [b.ws[0][l], b.ws[1][l], b.ws[2][l]];
             // Slip velocity v_ij − (v_ij·n)n + (R_i ω_i + R_j ω_j) × n (PHYSICS.md 2.3)
             let wn = [ws[1] * n[2] - ws[2] * n[1], ws[2] * n[0] - ws[0] * n[2], ws[0] * n[1] - ws[1] * n[0]];
             let vt = [vr[0] - vn * n[0] + wn[0], vr[1] - vn * n[1] + wn[1], vr[2] - vn * n[2] + wn[2]];
-            let s0 = [b.s[0][l] as f32, b.s[1][l] as f32, b.s[2][l] as f32];
+            let s0 = [b.s[0][l], b.s[1][l], b.s[2][l]];
             let mut s = [s0[0] + vt[0] * h, s0[1] + vt[1] * h, s0[2] + vt[2] * h];
             let sn = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
             s = [s[0] - sn * n[0], s[1] - sn * n[1], s[2] - sn * n[2]];
@@ -223,17 +229,17 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
                 let scaled = ft0[q] * scale;
                 ft[q] = if slide { scaled } else { ft0[q] };
                 let reset = -ft0[q] * qs;
-                b.s[q][l] = (if slide { reset } else { s[q] }) as f64;
+                b.s[q][l] = if slide { reset } else { s[q] };
                 f[q] += ft[q];
             }
-            b.c[0][l] = (n[1] * ft[2] - n[2] * ft[1]) as f64;
-            b.c[1][l] = (n[2] * ft[0] - n[0] * ft[2]) as f64;
-            b.c[2][l] = (n[0] * ft[1] - n[1] * ft[0]) as f64;
-            b.excess[l] = (ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim * lim) as f64;
-            b.lim2[l] = (lim * lim) as f64;
+            b.c[0][l] = n[1] * ft[2] - n[2] * ft[1];
+            b.c[1][l] = n[2] * ft[0] - n[0] * ft[2];
+            b.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
+            b.excess[l] = ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim * lim;
+            b.lim2[l] = lim * lim;
         }
         for (q, fq) in f.into_iter().enumerate() {
-            b.f[q][l] = fq as f64;
+            b.f[q][l] = fq;
         }
     }
 }

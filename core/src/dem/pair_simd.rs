@@ -54,7 +54,8 @@ pub unsafe fn scan8<const FR: bool>(
     }
     // r² = (dx₀² + dx₁²) + dx₂², as the scalar scan.
     let r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx[0], dx[0]), _mm512_mul_pd(dx[1], dx[1])), _mm512_mul_pd(dx[2], dx[2]));
-    let touch: __mmask8 = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(r2, _mm512_set1_pd(d2));
+    let d2v = _mm512_set1_pd(d2);
+    let touch: __mmask8 = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(r2, d2v);
     const BYTES: u64 = 0x0101_0101_0101_0101;
     if FR {
         // Per-entry byte flags: read "touched last step", write "touches now".
@@ -69,10 +70,13 @@ pub unsafe fn scan8<const FR: bool>(
     _mm256_storeu_si256(batch.k.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, kk));
     _mm256_storeu_si256(batch.i.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oi));
     _mm256_storeu_si256(batch.j.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oj));
+    // Rounded to single precision as `Batch::set` does.
+    let put = |lanes: &mut [f32; CAP], d: __m512d| _mm256_storeu_ps(lanes.as_mut_ptr().add(m), _mm256_maskz_compress_ps(touch, _mm512_cvtpd_ps(d)));
     for (a, d) in dx.iter().enumerate() {
-        _mm512_storeu_pd(batch.dx[a].as_mut_ptr().add(m), _mm512_maskz_compress_pd(touch, *d));
+        put(&mut batch.dx[a], *d);
     }
-    _mm512_storeu_pd(batch.r2.as_mut_ptr().add(m), _mm512_maskz_compress_pd(touch, r2));
+    put(&mut batch.r2, r2);
+    put(&mut batch.gap2, _mm512_sub_pd(d2v, r2));
     m + touch.count_ones() as usize
 }
 
@@ -106,7 +110,7 @@ pub unsafe fn gather8<const FR: bool>(
     for q in 0..3 {
         let vi = vrows.component(q);
         let vj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, vp.add(q));
-        _mm512_storeu_pd(batch.vrel[q].as_mut_ptr().add(l), _mm512_sub_pd(vi, vj));
+        _mm256_storeu_ps(batch.vrel[q].as_mut_ptr().add(l), _mm512_cvtpd_ps(_mm512_sub_pd(vi, vj)));
     }
     if !FR {
         return;
@@ -124,9 +128,8 @@ pub unsafe fn gather8<const FR: bool>(
     for q in 0..3 {
         let wi = wrows.component(q);
         let wj = _mm512_mask_i32gather_pd::<8>(z, valid, tj, wp.add(q));
-        _mm512_storeu_pd(batch.ws[q].as_mut_ptr().add(l), _mm512_mul_pd(rr, _mm512_add_pd(wi, wj)));
-        let sq = slots.component(q);
-        _mm512_storeu_pd(batch.s[q].as_mut_ptr().add(l), sq);
+        _mm256_storeu_ps(batch.ws[q].as_mut_ptr().add(l), _mm512_cvtpd_ps(_mm512_mul_pd(rr, _mm512_add_pd(wi, wj))));
+        _mm256_storeu_ps(batch.s[q].as_mut_ptr().add(l), slots.component(q));
     }
 }
 
@@ -146,7 +149,7 @@ pub unsafe fn write_back8(batch: &Batch, l: usize, valid: __mmask8, shear: &mut 
     let tk = _mm256_add_epi32(_mm256_add_epi32(kk, kk), kk);
     let sp = shear.as_mut_ptr() as *mut f32;
     for q in 0..3 {
-        let s = _mm512_cvtpd_ps(_mm512_loadu_pd(batch.s[q].as_ptr().add(l)));
+        let s = _mm256_loadu_ps(batch.s[q].as_ptr().add(l));
         _mm256_mask_i32scatter_ps::<4>(sp.add(q), valid, tk, s);
     }
 }
@@ -207,9 +210,9 @@ impl Rows {
 }
 
 /// Component q of eight lanes' histories (single precision, a `Hist` array at `p` of `len`
-/// slots, lanes `valid`, offsets `t` = 3 k, ascending, first lane k0, last valid lane kl), in
-/// double: from two vector loads and a permute when the lanes span at most ten slots, else a
-/// gather (the same values either way; lanes outside `valid` are zero).
+/// slots, lanes `valid`, offsets `t` = 3 k, ascending, first lane k0, last valid lane kl): from
+/// two vector loads and a permute when the lanes span at most ten slots, else a gather (the same
+/// values either way; lanes outside `valid` are zero).
 #[cfg(target_arch = "x86_64")]
 struct Slots {
     p: *const f32,
@@ -234,7 +237,7 @@ impl Slots {
     }
 
     #[inline(always)]
-    unsafe fn component(&self, q: usize) -> __m512d {
+    unsafe fn component(&self, q: usize) -> __m256 {
         let got = match self.near {
             Some(([a, b], rel)) => {
                 let idx = _mm512_zextsi256_si512(_mm256_add_epi32(rel, _mm256_set1_epi32(q as i32)));
@@ -242,7 +245,7 @@ impl Slots {
             }
             None => _mm256_mmask_i32gather_ps::<4>(_mm256_setzero_ps(), self.valid, self.t, self.p.add(q)),
         };
-        _mm512_maskz_cvtps_pd(self.valid, got)
+        _mm256_maskz_mov_ps(self.valid, got)
     }
 }
 
@@ -282,11 +285,11 @@ mod tests {
                 let s = Slots::new(hist.as_ptr() as *const f32, i0, rows[nvalid - 1], len, tv, mask);
                 for q in 0..3 {
                     let got: [f64; 8] = std::mem::transmute(r.component(q));
-                    let got_hist: [f64; 8] = std::mem::transmute(s.component(q));
+                    let got_hist: [f32; 8] = std::mem::transmute(s.component(q));
                     for lane in 0..8 {
                         let want = if mask >> lane & 1 == 1 { data[rows[lane]][q] } else { 0.0 };
                         assert_eq!(got[lane], want, "case {case}: span {span}, first row {i0}, lane {lane}, component {q}");
-                        assert_eq!(got_hist[lane], want, "histories: case {case}, span {span}, lane {lane}, component {q}");
+                        assert_eq!(got_hist[lane] as f64, want, "histories: case {case}, span {span}, lane {lane}, component {q}");
                     }
                 }
             }

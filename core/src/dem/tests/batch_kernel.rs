@@ -44,11 +44,11 @@ fn batch_against_scalar_law(n: usize) {
         for l in 0..n {
             let (i, j) = (2 * l, 2 * l + 1);
             let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-            b.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]);
+            b.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], 4.0 * r * r);
         }
         for l in n..CAP {
             let junk = [[0.0; 3], [f64::NAN; 3], [1e-9, 0.0, 0.0]][l % 3];
-            b.set(l, 0, 0, 1, junk, junk[0] * junk[0]);
+            b.set(l, 0, 0, 1, junk, junk[0] * junk[0], 4.0 * r * r);
         }
         b.m = n;
         b
@@ -66,7 +66,7 @@ fn batch_against_scalar_law(n: usize) {
     let maxima = batch.evaluate::<true, false>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
     if let Some((b2, s2, m2)) = &vector {
         // the AVX-512 gather (`pair_simd::gather8`) gives the same lanes as the portable one
-        let valid = |a: &[[f64; CAP]; 3]| a.map(|q| q[..n].to_vec());
+        let valid = |a: &[[f32; CAP]; 3]| a.map(|q| q[..n].to_vec());
         assert_eq!(valid(&b2.f), valid(&batch.f), "vector gather: forces");
         assert_eq!(valid(&b2.c), valid(&batch.c), "vector gather: torques");
         assert_eq!(s2, &shear, "vector gather: histories");
@@ -89,8 +89,8 @@ fn batch_against_scalar_law(n: usize) {
             let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt() / (b[0] * b[0] + b[1] * b[1] + b[2] * b[2]).sqrt()
         };
-        worst[0] = worst[0].max(err([batch.f[0][l], batch.f[1][l], batch.f[2][l]], cf.f));
-        worst[1] = worst[1].max(err([batch.c[0][l], batch.c[1][l], batch.c[2][l]], cf.c));
+        worst[0] = worst[0].max(err([batch.f[0][l], batch.f[1][l], batch.f[2][l]].map(f64::from), cf.f));
+        worst[1] = worst[1].max(err([batch.c[0][l], batch.c[1][l], batch.c[2][l]].map(f64::from), cf.c));
         worst[2] = worst[2].max(err(shear[l].map(f64::from), s));
         slid += (cf.excess > -1e-9) as usize;
         max_delta = max_delta.max(2.0 * r - dist);
