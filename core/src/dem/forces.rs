@@ -50,15 +50,20 @@ pub struct Stats {
     pub overlap: f64,
     pub coulomb_excess: f64,
     pub disp2: f64,
+    /// Largest |component| of a position's change in the step, and of a new position (m).
+    pub moved: f64,
+    pub extent: f64,
 }
 
 impl Stats {
-    pub const ZERO: Stats = Stats { overlap: 0.0, coulomb_excess: f64::NEG_INFINITY, disp2: 0.0 };
+    pub const ZERO: Stats = Stats { overlap: 0.0, coulomb_excess: f64::NEG_INFINITY, disp2: 0.0, moved: 0.0, extent: 0.0 };
     pub fn max(self, o: Stats) -> Stats {
         Stats {
             overlap: self.overlap.max(o.overlap),
             coulomb_excess: self.coulomb_excess.max(o.coulomb_excess),
             disp2: self.disp2.max(o.disp2),
+            moved: self.moved.max(o.moved),
+            extent: self.extent.max(o.extent),
         }
     }
 }

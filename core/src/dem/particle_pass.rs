@@ -127,7 +127,8 @@ pub struct Motion<'a> {
     pub v: &'a mut [V3],
     pub w: &'a mut [V3],
     pub past: &'a mut Past,
-    /// Positions the largest displacement is measured from (the last near-list refresh).
+    /// Positions the largest displacement is measured from (the last near-list refresh);
+    /// empty: not measured this step.
     pub x_ref: &'a [V3],
     pub walls: &'a mut WallList,
 }
@@ -204,12 +205,21 @@ unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: Blo
 }
 
 /// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), then f_older ← f (flat arrays, vectorised).
+/// Returns the largest |increment| and |new y| (eight partial maxima each, so the loop stays a
+/// vector loop; unused results cost nothing once inlined).
 #[inline(always)]
-fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
-    for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
-        *y += hb[0] * f + hb[1] * f1 + hb[2] * *f2;
+fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
+    let (mut inc_max, mut y_max) = ([0.0f64; 8], [0.0f64; 8]);
+    for (k, (((y, &f), &f1), f2)) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()).enumerate() {
+        let inc = hb[0] * f + hb[1] * f1 + hb[2] * *f2;
+        *y += inc;
         *f2 = f;
+        let (a, b) = (inc.abs(), y.abs());
+        inc_max[k % 8] = if a > inc_max[k % 8] { a } else { inc_max[k % 8] };
+        y_max[k % 8] = if b > y_max[k % 8] { b } else { y_max[k % 8] };
     }
+    let top = |p: [f64; 8]| p.iter().fold(0.0f64, |a, &b| if b > a { b } else { a });
+    (top(inc_max), top(y_max))
 }
 
 #[inline(always)]
@@ -226,10 +236,13 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();
-    ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
+    (st.moved, st.extent) = ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
     ab_flat(hb, v.as_flattened_mut(), a.as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al.as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
+    }
+    if x_ref.is_empty() {
+        return st; // the system's bound on the displacement stands in for the check
     }
     // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).

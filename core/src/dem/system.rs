@@ -14,6 +14,7 @@ use super::neighbors::{build_list, cell_order, NeighborList};
 use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// The complete DEM state; serde gives checkpoints with bit-identical continuation.
@@ -49,6 +50,15 @@ pub struct DemSystem {
     #[serde(skip)]
     team_steps: u64,
     last: (f64, f64),
+    /// An upper bound on the largest displacement since the last near-list refresh, grown by
+    /// each step's largest move, so that the exact check against `x_near` (a pass over every
+    /// position, ~3% of a step) runs only when the bound nears the refresh distance; the
+    /// refreshes fall on the same steps. Unknown (+∞) after a restore, and `last_move` (the
+    /// last step's largest move) 0.
+    #[serde(skip, default = "unknown_bound")]
+    moved_bound: f64,
+    #[serde(skip)]
+    last_move: f64,
     /// Storage reused by near-list refreshes (the previous list's, and a code per entry).
     #[serde(skip)]
     spare: (NearList, Vec<u32>),
@@ -90,6 +100,8 @@ impl DemSystem {
             builds: (0, 0),
             team_steps: 0,
             last: (0.0, f64::NEG_INFINITY),
+            moved_bound: unknown_bound(),
+            last_move: 0.0,
             spare: Default::default(),
             sc_threads: 0,
             sc: Scratch::default(),
@@ -246,7 +258,13 @@ impl DemSystem {
             self.sc.replan(&self.near.list, self.x.len(), chunks);
             self.sc_threads = chunks;
         }
-        let refresh_disp2 = self.p.near_move() * self.p.near_move();
+        let limit = self.p.near_move();
+        let refresh_disp2 = limit * limit;
+        // Measure exactly when the bound, grown by twice the last step's move, could pass the
+        // limit; a step whose move exceeds that is measured after it (below).
+        let safe = limit * (1.0 - 1e-9);
+        let exact = self.levels == 0 || self.moved_bound + 2.0 * SQRT_3 * self.last_move >= safe;
+        let x_ref = if exact { &self.x_near[..] } else { &[] };
         let st = if self.levels == 0 {
             let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
             let st = st1.max(self.heun::<FR>());
@@ -268,7 +286,7 @@ impl DemSystem {
                         sc: &mut self.sc,
                     };
                     self.team_steps += 1;
-                    team_step::<FR>(&self.p, hb, self.ring as usize, s, &self.x_near, &self.ext)
+                    team_step::<FR>(&self.p, hb, self.ring as usize, s, x_ref, &self.ext)
                 }
                 // Two parallel loops, which cannot wait on another team's threads.
                 None => {
@@ -278,7 +296,7 @@ impl DemSystem {
                         v: &mut self.v,
                         w: &mut self.w,
                         past: &mut self.past,
-                        x_ref: &self.x_near,
+                        x_ref,
                         walls: &mut self.walls,
                     };
                     st1.max(update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, self.sc.sums()))
@@ -289,7 +307,24 @@ impl DemSystem {
             st
         };
         self.last = (st.overlap, st.coulomb_excess);
-        if st.disp2 > refresh_disp2 {
+        self.last_move = st.moved;
+        let (disp2, measured) = if exact {
+            (st.disp2, true)
+        } else {
+            // |Δx| ≤ √3 (max |Δx_k| + rounding of the new coordinate, ≤ ε/2 of it).
+            let grown = self.moved_bound + SQRT_3 * (st.moved + 0.5 * f64::EPSILON * st.extent) * (1.0 + 1e-12);
+            if grown < safe {
+                self.moved_bound = grown;
+                (0.0, false) // below the limit (and so below the exact check's result) for certain
+            } else {
+                (self.largest_disp2(), true)
+            }
+        };
+        if measured {
+            // The computed distance is within a few ε of the true one.
+            self.moved_bound = disp2.sqrt() * (1.0 + 1e-12);
+        }
+        if disp2 > refresh_disp2 {
             self.refresh();
         }
         if self.rebuild_due {
@@ -314,7 +349,26 @@ impl DemSystem {
         std::mem::swap(&mut self.near, spare);
         self.sc.bounds.clear(); // replanned for the new list at the next step
         self.x_near.clone_from(&self.x);
+        self.moved_bound = 0.0;
         self.builds.1 += 1;
+    }
+
+    /// The displacement bound and the largest displacement since the last refresh (tests).
+    #[cfg(test)]
+    pub(super) fn moved_bound_and_largest(&self) -> (f64, f64) {
+        (self.moved_bound, self.largest_disp2().sqrt())
+    }
+
+    /// The largest squared displacement since the last refresh (as the particle pass measures it).
+    fn largest_disp2(&self) -> f64 {
+        self.x
+            .par_iter()
+            .zip(&self.x_near)
+            .map(|(a, b)| {
+                let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+            })
+            .reduce(|| 0.0, f64::max)
     }
 
     /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
@@ -396,7 +450,15 @@ impl DemSystem {
         self.sc.bounds.clear(); // replanned for the new list at the next step
         self.x_build.clone_from(&self.x);
         self.x_near.clone_from(&self.x);
+        self.moved_bound = 0.0;
         self.rebuild_due = false;
         self.builds.0 += 1;
     }
+}
+
+/// √3, rounded up (the bound's factor from the largest component to the length).
+const SQRT_3: f64 = 1.7320508075688774;
+
+fn unknown_bound() -> f64 {
+    f64::INFINITY
 }

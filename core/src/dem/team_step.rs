@@ -132,11 +132,11 @@ pub struct StepState<'a> {
 }
 
 /// The pair pass and the fused particle pass of one step: weights `hb` (= h·b), newer past
-/// slot `ring`, displacements measured from `x_ref`.
+/// slot `ring`, displacements measured from `x_ref` (unless it is empty).
 pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: StepState, x_ref: &[V3], ext: &[V3]) -> Stats {
     let StepState { x, v, w, past, walls, nl, sc } = s;
     let n = x.len();
-    assert!(v.len() == n && w.len() == n && x_ref.len() == n && (ext.is_empty() || ext.len() == n));
+    assert!(v.len() == n && w.len() == n && (x_ref.is_empty() || x_ref.len() == n) && (ext.is_empty() || ext.len() == n));
     assert!(past.v.iter().chain(&past.a).chain(&past.alpha).all(|s| s.len() == n), "past derivatives");
     let (offsets, nbr) = (&nl.offsets[..], &nl.nbr[..]);
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);

@@ -32,6 +32,10 @@ fn near_list_holds_every_touching_pair() {
     let mut touching_seen = 0;
     for _ in 0..2000 {
         s.step();
+        // The running bound that stands in for the exact displacement check never falls below
+        // the largest displacement since the refresh.
+        let (bound, largest) = s.moved_bound_and_largest();
+        assert!(bound >= largest, "bound {bound:e} below the displacement {largest:e} at step {}", s.steps());
         let listed = near_pairs(&s);
         let x = s.positions();
         for i in 0..x.len() {
