@@ -209,14 +209,25 @@ unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: Blo
 /// vector loop; unused results cost nothing once inlined).
 #[inline(always)]
 fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
+    let n = y.len();
+    assert!(f.len() == n && newer.len() == n && older.len() == n);
     let (mut inc_max, mut y_max) = ([0.0f64; 8], [0.0f64; 8]);
-    for (k, (((y, &f), &f1), f2)) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()).enumerate() {
-        let inc = hb[0] * f + hb[1] * f1 + hb[2] * *f2;
-        *y += inc;
-        *f2 = f;
-        let (a, b) = (inc.abs(), y.abs());
-        inc_max[k % 8] = if a > inc_max[k % 8] { a } else { inc_max[k % 8] };
-        y_max[k % 8] = if b > y_max[k % 8] { b } else { y_max[k % 8] };
+    let mut one = |k: usize, q: usize| {
+        let inc = hb[0] * f[k] + hb[1] * newer[k] + hb[2] * older[k];
+        y[k] += inc;
+        older[k] = f[k];
+        let (a, b) = (inc.abs(), y[k].abs());
+        inc_max[q] = if a > inc_max[q] { a } else { inc_max[q] };
+        y_max[q] = if b > y_max[q] { b } else { y_max[q] };
+    };
+    // In groups of eight (the partial maxima's lanes), so the loop is a vector loop.
+    for g in 0..n / 8 {
+        for q in 0..8 {
+            one(8 * g + q, q);
+        }
+    }
+    for k in n / 8 * 8..n {
+        one(k, 0);
     }
     let top = |p: [f64; 8]| p.iter().fold(0.0f64, |a, &b| if b > a { b } else { a });
     (top(inc_max), top(y_max))
