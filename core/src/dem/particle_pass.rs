@@ -209,25 +209,28 @@ unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: Blo
 /// vector loop; unused results cost nothing once inlined).
 #[inline(always)]
 fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
-    let n = y.len();
-    assert!(f.len() == n && newer.len() == n && older.len() == n);
     let (mut inc_max, mut y_max) = ([0.0f64; 8], [0.0f64; 8]);
-    let mut one = |k: usize, q: usize| {
-        let inc = hb[0] * f[k] + hb[1] * newer[k] + hb[2] * older[k];
-        y[k] += inc;
-        older[k] = f[k];
-        let (a, b) = (inc.abs(), y[k].abs());
+    let mut one = |y: &mut f64, f: f64, f1: f64, f2: &mut f64, q: usize| {
+        let inc = hb[0] * f + hb[1] * f1 + hb[2] * *f2;
+        *y += inc;
+        *f2 = f;
+        let (a, b) = (inc.abs(), y.abs());
         inc_max[q] = if a > inc_max[q] { a } else { inc_max[q] };
         y_max[q] = if b > y_max[q] { b } else { y_max[q] };
     };
-    // In groups of eight (the partial maxima's lanes), so the loop is a vector loop.
-    for g in 0..n / 8 {
+    // Groups of eight as arrays (the partial maxima's lanes), so the loop is a vector loop.
+    let (mut gy, mut gf) = (y.chunks_exact_mut(8), f.chunks_exact(8));
+    let (mut gn, mut go) = (newer.chunks_exact(8), older.chunks_exact_mut(8));
+    for (((y, f), f1), f2) in (&mut gy).zip(&mut gf).zip(&mut gn).zip(&mut go) {
+        let (y, f): (&mut [f64; 8], &[f64; 8]) = (y.try_into().unwrap(), f.try_into().unwrap());
+        let (f1, f2): (&[f64; 8], &mut [f64; 8]) = (f1.try_into().unwrap(), f2.try_into().unwrap());
         for q in 0..8 {
-            one(8 * g + q, q);
+            one(&mut y[q], f[q], f1[q], &mut f2[q], q);
         }
     }
-    for k in n / 8 * 8..n {
-        one(k, 0);
+    let rest = gy.into_remainder().iter_mut().zip(gf.remainder()).zip(gn.remainder()).zip(go.into_remainder());
+    for (((y, &f), &f1), f2) in rest {
+        one(y, f, f1, f2, 0);
     }
     let top = |p: [f64; 8]| p.iter().fold(0.0f64, |a, &b| if b > a { b } else { a });
     (top(inc_max), top(y_max))
