@@ -2,6 +2,7 @@
 //!
 //! - `contact`: the contact law (PHYSICS.md 2), one kernel for pairs and walls;
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
+//! - `ab_update`: the AB update on flat arrays (with the largest move, for positions);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
 //! - `near_list`: the Verlet list's entries within a small gap, the list the pair pass walks;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
@@ -14,6 +15,7 @@
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
 
+pub mod ab_update;
 pub mod bed;
 pub mod contact;
 pub mod forces;

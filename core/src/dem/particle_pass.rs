@@ -3,6 +3,7 @@
 //! the AB3 update on flat arrays (PHYSICS.md 7). Blocks are fixed, so results do not depend on
 //! the thread count.
 
+use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::V3;
 use super::forces::{Acc, Past, Stats};
 use super::work_split::Sums;
@@ -204,38 +205,6 @@ unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: Blo
     update_block::<FR>(p, hb, bm, xb, ext, sc)
 }
 
-/// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), then f_older ← f (flat arrays, vectorised).
-/// Returns the largest |increment| and |new y| (eight partial maxima each, so the loop stays a
-/// vector loop; unused results cost nothing once inlined).
-#[inline(always)]
-fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
-    let (mut inc_max, mut y_max) = ([0.0f64; 8], [0.0f64; 8]);
-    let mut one = |y: &mut f64, f: f64, f1: f64, f2: &mut f64, q: usize| {
-        let inc = hb[0] * f + hb[1] * f1 + hb[2] * *f2;
-        *y += inc;
-        *f2 = f;
-        let (a, b) = (inc.abs(), y.abs());
-        inc_max[q] = if a > inc_max[q] { a } else { inc_max[q] };
-        y_max[q] = if b > y_max[q] { b } else { y_max[q] };
-    };
-    // Groups of eight as arrays (the partial maxima's lanes), so the loop is a vector loop.
-    let (mut gy, mut gf) = (y.chunks_exact_mut(8), f.chunks_exact(8));
-    let (mut gn, mut go) = (newer.chunks_exact(8), older.chunks_exact_mut(8));
-    for (((y, f), f1), f2) in (&mut gy).zip(&mut gf).zip(&mut gn).zip(&mut go) {
-        let (y, f): (&mut [f64; 8], &[f64; 8]) = (y.try_into().unwrap(), f.try_into().unwrap());
-        let (f1, f2): (&[f64; 8], &mut [f64; 8]) = (f1.try_into().unwrap(), f2.try_into().unwrap());
-        for q in 0..8 {
-            one(&mut y[q], f[q], f1[q], &mut f2[q], q);
-        }
-    }
-    let rest = gy.into_remainder().iter_mut().zip(gf.remainder()).zip(gn.remainder()).zip(go.into_remainder());
-    for (((y, &f), &f1), f2) in rest {
-        one(y, f, f1, f2, 0);
-    }
-    let top = |p: [f64; 8]| p.iter().fold(0.0f64, |a, &b| if b > a { b } else { a });
-    (top(inc_max), top(y_max))
-}
-
 #[inline(always)]
 fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_ref: &[V3], ext: &[V3], sc: Sums) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
@@ -250,7 +219,7 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();
-    (st.moved, st.extent) = ab_flat(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
+    (st.moved, st.extent) = ab_flat_moved(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
     ab_flat(hb, v.as_flattened_mut(), a.as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al.as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());
