@@ -4,7 +4,7 @@
 //! the thread count.
 
 use super::ab_update::{ab_flat, ab_flat_moved};
-use super::contact::V3;
+use super::contact::{dist2, V3};
 use super::forces::{Acc, Past, Stats};
 use super::work_split::Sums;
 use super::walls::{wall_forces, WallList};
@@ -230,9 +230,8 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).
     let mut part = [0.0f64; 8];
-    for (l, (xn, xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
-        let dd = [xn[0] - xb[0], xn[1] - xb[1], xn[2] - xb[2]];
-        let d2 = dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2];
+    for (l, (&xn, &xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
+        let d2 = dist2(xn, xb);
         part[l % 8] = if d2 > part[l % 8] { d2 } else { part[l % 8] };
     }
     st.disp2 = part.iter().fold(st.disp2, |a, &b| if b > a { b } else { a });

@@ -4,7 +4,7 @@
 //! when any particle moved more than about half the near gap, with a Verlet-list rebuild and
 //! re-sort first if the list could miss a near pair.
 
-use super::contact::V3;
+use super::contact::{dist2, V3};
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
 use super::particle_pass::{accel_pass, update_pass, Motion};
 use super::team_step::{team_step, StepState, TeamLock};
@@ -336,10 +336,7 @@ impl DemSystem {
     /// far enough since its build that it might miss a pair closer than d + near gap.
     fn refresh(&mut self) {
         let reach = self.p.outer_move();
-        let moved = self.x.iter().zip(&self.x_build).any(|(a, b)| {
-            let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-            d[0] * d[0] + d[1] * d[1] + d[2] * d[2] > reach * reach
-        });
+        let moved = self.x.iter().zip(&self.x_build).any(|(&a, &b)| dist2(a, b) > reach * reach);
         if moved {
             self.rebuild_due = true;
             return;
@@ -361,14 +358,7 @@ impl DemSystem {
 
     /// The largest squared displacement since the last refresh (as the particle pass measures it).
     fn largest_disp2(&self) -> f64 {
-        self.x
-            .par_iter()
-            .zip(&self.x_near)
-            .map(|(a, b)| {
-                let d = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-                d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-            })
-            .reduce(|| 0.0, f64::max)
+        self.x.par_iter().zip(&self.x_near).map(|(&a, &b)| dist2(a, b)).reduce(|| 0.0, f64::max)
     }
 
     /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
@@ -391,7 +381,6 @@ impl DemSystem {
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
         accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
         (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
-        let mut disp2: f64 = 0.0;
         let newer = 1 - self.ring as usize;
         for i in 0..n {
             let vs = self.v[i];
@@ -404,13 +393,10 @@ impl DemSystem {
             q.v[newer][i] = v0[i];
             q.a[newer][i] = [d0[i][0], d0[i][1], d0[i][2]];
             q.alpha[newer][i] = [d0[i][3], d0[i][4], d0[i][5]];
-            let xb = self.x_near[i];
-            let d: f64 = (0..3).map(|k| (self.x[i][k] - xb[k]).powi(2)).sum();
-            disp2 = disp2.max(d);
         }
         self.ring = newer as u8;
         self.levels = 2;
-        Stats { disp2, ..st }
+        Stats { disp2: self.largest_disp2(), ..st }
     }
 
     /// Replace the parameters mid-run (bed pouring stiffens the contacts in stages). The state
