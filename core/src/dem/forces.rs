@@ -1,6 +1,7 @@
 //! The two parallel passes of a DEM step, bit-reproducible for a given work split (chunk count):
 //! 1. pair pass: every listed pair once (half list), contiguous particle chunks in parallel, each
-//!    adding the pair forces on i and j into its own buffer (no atomics, no races); a listed pair
+//!    adding the pair forces on i and j into its own buffer (no atomics, no races; single
+//!    precision rows, `pair_scatter`); a listed pair
 //!    costs a distance check, only touching pairs go to the batched contact kernel;
 //! 2. the particle pass (`particle_pass`): per block, sum the chunk buffers in chunk order, add
 //!    walls (only for the wall list), gravity and the external force, and advance by AB3.
@@ -9,6 +10,7 @@
 //! (the multistep steps); `pair_pass` alone serves the start-up and the fallback.
 
 use super::pair_batch::{Batch, CAP};
+use super::pair_scatter::{scatter, PairSum};
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{scan8, LANES};
 use super::contact::{ContactLaw, V3};
@@ -131,7 +133,7 @@ pub(super) struct ChunkArgs<'a> {
     pub w: &'a [V3],
 }
 
-pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f")
@@ -151,13 +153,13 @@ pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
-unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
     chunk_pairs::<FR, true>(c, sh, to, acc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
     chunk_pairs::<FR, false>(c, sh, to, acc)
 }
 
@@ -165,9 +167,9 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &
 /// added into `acc` (particles a..). Particles are read only in the window a..e, and the batch
 /// lanes hold indices into it (particle − a).
 #[inline(always)]
-fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [Acc]) -> Stats {
+fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
     let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
-    acc.fill([0.0; 6]);
+    acc.fill(PairSum::default());
     let mut st = Stats::ZERO;
     let (base, end) = (offsets[a] as usize, offsets[b] as usize);
     let mut batch = Batch::new();
@@ -229,26 +231,11 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
     batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
-    acc: &mut [Acc], st: &mut Stats,
+    acc: &mut [PairSum], st: &mut Stats,
 ) {
     let (ov, ex) = batch.evaluate::<FR, V>(law, r, h, v, w, sh, base);
     st.overlap = st.overlap.max(ov);
     st.coulomb_excess = st.coulomb_excess.max(ex);
-    for l in 0..batch.m {
-        let (ii, jj) = (batch.i[l] as usize, batch.j[l] as usize);
-        let f = [batch.f[0][l] as f64, batch.f[1][l] as f64, batch.f[2][l] as f64];
-        let c = if FR { [batch.c[0][l] as f64, batch.c[1][l] as f64, batch.c[2][l] as f64] } else { [0.0; 3] };
-        // F on i, −F on j; both partners feel R n × F_t (contact points ±R n, forces ±F_t).
-        let on_i = [f[0], f[1], f[2], c[0], c[1], c[2]];
-        let on_j = [-f[0], -f[1], -f[2], c[0], c[1], c[2]];
-        let ai = &mut acc[ii];
-        for q in 0..6 {
-            ai[q] += on_i[q];
-        }
-        let aj = &mut acc[jj];
-        for q in 0..6 {
-            aj[q] += on_j[q];
-        }
-    }
+    scatter::<FR, V>(batch, acc);
     batch.m = 0;
 }

@@ -23,6 +23,7 @@ pub mod integrator;
 pub mod near_list;
 pub mod neighbors;
 pub mod pair_batch;
+pub mod pair_scatter;
 pub mod particle_pass;
 pub mod pair_simd;
 pub mod steal_ranges;

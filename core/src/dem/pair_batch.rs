@@ -1,6 +1,6 @@
 //! The particle-particle contact law of `contact::contact_force`, evaluated for a batch of
 //! touching pairs at a time (PHYSICS.md 2.2-2.3), in single precision from double-precision
-//! positions, velocities and histories (see `lanes`; forces are summed in double). The lanes
+//! positions, velocities and histories (see `lanes`; `pair_scatter` sums the forces). The lanes
 //! hold single-precision values only (each rounded once from the double it is formed in), so
 //! the lane loop is all single precision and runs sixteen lanes per AVX-512 vector.
 //!

@@ -49,7 +49,7 @@ fn block_forces<'o, const FR: bool>(
             let buf = sc.rows(c, s, t);
             for (o, q) in out[s - lo..t - lo].iter_mut().zip(buf) {
                 for k in 0..6 {
-                    o[k] += q[k];
+                    o[k] += q.0[k] as f64;
                 }
             }
         }

@@ -9,7 +9,8 @@
 //! buffers and blocks, whichever thread takes them), so every bit of the result is the same.
 
 use super::contact::V3;
-use super::forces::{chunk_pairs_dispatch, Acc, ChunkArgs, Past, Scratch, Stats};
+use super::forces::{chunk_pairs_dispatch, ChunkArgs, Past, Scratch, Stats};
+use super::pair_scatter::PairSum;
 use super::neighbors::{Hist, NeighborList};
 use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
 use super::steal_ranges::StealRanges;
@@ -226,5 +227,5 @@ struct Shared {
     whist: Raw<[V3; 3]>,
     shear: Raw<Hist>,
     touch: Raw<u8>,
-    acc: Raw<Acc>,
+    acc: Raw<PairSum>,
 }

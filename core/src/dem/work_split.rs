@@ -1,7 +1,7 @@
 //! The work split of the pair pass (`Scratch`): contiguous particle chunks of about equal work,
 //! each with a private force buffer, planned once per neighbour-list build.
 
-use super::forces::Acc;
+use super::pair_scatter::PairSum;
 use super::neighbors::NeighborList;
 use rayon::prelude::*;
 
@@ -20,7 +20,7 @@ pub struct Scratch {
     pub bounds: Vec<[usize; 3]>,
     /// Start of each chunk's buffer in `acc`.
     pub start: Vec<usize>,
-    pub acc: Vec<Acc>,
+    pub acc: Vec<PairSum>,
     /// Row (first particle) of every list entry.
     pub owner: Vec<u32>,
 }
@@ -32,9 +32,9 @@ pub struct Scratch {
 pub struct Sums<'a> {
     pub bounds: &'a [[usize; 3]],
     start: &'a [usize],
-    acc: *const Acc,
+    acc: *const PairSum,
     len: usize,
-    life: std::marker::PhantomData<&'a [Acc]>,
+    life: std::marker::PhantomData<&'a [PairSum]>,
 }
 
 // SAFETY: a read-only view; `Sums::new` borrows the buffers, `Sums::from_raw`'s caller keeps
@@ -43,7 +43,7 @@ unsafe impl Send for Sums<'_> {}
 unsafe impl Sync for Sums<'_> {}
 
 impl<'a> Sums<'a> {
-    pub fn new(bounds: &'a [[usize; 3]], start: &'a [usize], acc: &'a [Acc]) -> Self {
+    pub fn new(bounds: &'a [[usize; 3]], start: &'a [usize], acc: &'a [PairSum]) -> Self {
         // SAFETY: `acc` is borrowed (shared) for 'a.
         unsafe { Self::from_raw(bounds, start, acc.as_ptr(), acc.len()) }
     }
@@ -51,13 +51,13 @@ impl<'a> Sums<'a> {
     /// # Safety
     /// `acc` points to `len` buffers rows valid for 'a, and no row read through `rows` is
     /// written while the returned slice lives.
-    pub unsafe fn from_raw(bounds: &'a [[usize; 3]], start: &'a [usize], acc: *const Acc, len: usize) -> Self {
+    pub unsafe fn from_raw(bounds: &'a [[usize; 3]], start: &'a [usize], acc: *const PairSum, len: usize) -> Self {
         assert!(start.len() > bounds.len() && bounds.iter().zip(start).all(|(&[a, _, e], &s)| s + e - a <= len), "chunk buffers");
         Sums { bounds, start, acc, len, life: std::marker::PhantomData }
     }
 
     /// Chunk c's buffer rows of particles s..t (within its window a..e).
-    pub fn rows(&self, c: usize, s: usize, t: usize) -> &'a [Acc] {
+    pub fn rows(&self, c: usize, s: usize, t: usize) -> &'a [PairSum] {
         let [a, _, e] = self.bounds[c];
         assert!(a <= s && s <= t && t <= e, "rows {s}..{t} outside chunk window {a}..{e}");
         let lo = self.start[c] + s - a;
@@ -139,7 +139,7 @@ impl Scratch {
             start.push(start[c] + e - a);
         }
         acc.clear();
-        acc.resize(start[nc], [0.0; 6]);
+        acc.resize(start[nc], PairSum::default());
         *self = Scratch { bounds, start, acc, owner };
     }
 }

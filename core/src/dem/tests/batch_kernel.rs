@@ -5,6 +5,7 @@
 use super::{test_case, with_damping};
 use crate::dem::contact::contact_force;
 use crate::dem::pair_batch::{Batch, CAP};
+use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemParams;
 use rand::{Rng, SeedableRng};
 
@@ -163,7 +164,7 @@ fn vector_pair_pass_equals_the_portable_one() {
     let first_diff = |a: Vec<u64>, b: Vec<u64>| a.iter().zip(&b).position(|(x, y)| x != y);
     let flags = |t: &[u8]| t.iter().map(|&f| f as u64).collect::<Vec<_>>();
     assert_eq!(first_diff(flags(&portable.3), flags(&vector.3)), None, "contact flags");
-    let bits = |a: &[[f64; 6]]| a.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(|f| f.to_bits() as u64).collect::<Vec<_>>();
     assert_eq!(first_diff(bits(&portable.2), bits(&vector.2)), None, "forces and torques (first differing value)");
     let bits3 = |a: &[[f32; 3]]| a.iter().flatten().map(|f| f.to_bits() as u64).collect::<Vec<_>>();
     assert_eq!(first_diff(bits3(&portable.4), bits3(&vector.4)), None, "histories (first differing value)");

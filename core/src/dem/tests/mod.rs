@@ -6,6 +6,7 @@ mod checkpoint;
 mod energy;
 mod integrator_order;
 mod near_list;
+mod pair_scatter;
 mod poured_bed;
 mod restitution;
 mod sliding;

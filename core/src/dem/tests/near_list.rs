@@ -5,6 +5,7 @@
 use super::energy::random_gas;
 use super::{test_case, with_damping};
 use crate::dem::forces::{pair_pass, Kernels, Scratch};
+use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemSystem;
 use crate::dem::near_list::{Histories, NearList};
 use std::collections::{HashMap, HashSet};
@@ -95,7 +96,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
         let mut sc = Scratch::plan(nl, n, 1);
         pair_pass::<true>(&s.p, &s.x, &s.v, &s.w, nl, &mut sc, Kernels::Best);
         let mut acc = sc.acc;
-        acc.resize(n, [0.0; 6]);
+        acc.resize(n, Default::default());
         acc
     };
     let mut near = s.near.list.clone();
@@ -103,7 +104,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     let touching = near.touch.iter().filter(|&&t| t == 1).count();
     assert!(touching > 500 && touching < near.nbr.len(), "{touching} of {} near entries touch", near.nbr.len());
     assert!(near.nbr.len() < outer.nbr.len(), "the near list is the whole list");
-    let bits = |a: &[[f64; 6]]| a.iter().flatten().map(|f| f.to_bits()).collect::<Vec<_>>();
+    let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(f32::to_bits).collect::<Vec<_>>();
     assert!(bits(&on_near) == bits(&on_outer), "forces and torques differ");
     // Every entry left out of the near list does not touch; the kept ones agree exactly.
     let kept: HashSet<u32> = s.near.src.iter().copied().collect();
