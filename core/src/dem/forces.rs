@@ -1,8 +1,8 @@
 //! The two parallel passes of a DEM step, bit-reproducible for a given work split (chunk count):
 //! 1. pair pass: every listed pair once (half list), contiguous particle chunks in parallel, each
-//!    adding the pair forces on i and j into its own buffer (no atomics, no races; single
-//!    precision rows, `pair_scatter`); a listed pair
-//!    costs a distance check, only touching pairs go to the batched contact kernel;
+//!    adding the pair forces on i and j into its own buffer (no atomics, no races; rows in
+//!    single precision, `pair_scatter`); a listed pair costs a distance check, only touching
+//!    pairs go to the batched contact kernel;
 //! 2. the particle pass (`particle_pass`): per block, sum the chunk buffers in chunk order, add
 //!    walls (only for the wall list), gravity and the external force, and advance by AB3.
 //!

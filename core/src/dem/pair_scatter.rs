@@ -1,7 +1,7 @@
 //! The pair forces of a batch added into a chunk buffer: F on i, −F on j, and R n × F_t on both
 //! (contact points ±R n, forces ±F_t). The buffer's rows are single precision, eight floats
-//! (32 bytes, aligned) per particle, so the partner side, the largest cost of the pair pass
-//! after the contact law, is one vector load, add and store, and no row crosses a cache line
+//! (32 bytes, aligned) per particle, so the partner side (j), which had been the largest single
+//! cost left in the pair pass, is one vector load, add and store, and no row crosses a cache line
 //! (docs/BENCHMARKS.md, "Chunk sums in single precision"). The particle pass adds the chunks'
 //! rows in double.
 //!
@@ -47,7 +47,8 @@ pub fn scatter<const FR: bool, const V: bool>(b: &Batch, acc: &mut [PairSum]) {
 /// scalar loop (the sign flip is exact), so the same bits.
 ///
 /// # Safety
-/// The CPU has AVX; l + 8 ≤ CAP.
+/// The CPU has avx512f and avx512vl (the instructions are AVX; the feature set is the pair
+/// pass's); l + 8 ≤ CAP.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl")]
 unsafe fn scatter8<const FR: bool>(b: &Batch, l: usize, cnt: usize, acc: &mut [PairSum]) {
