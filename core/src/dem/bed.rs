@@ -68,7 +68,7 @@ pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<
             }
         }
     }
-    let bed = generate(case, g.count, g.settled_height_m, g.seed, &mut |_| {})?;
+    let bed = generate(case, g.count, g.settled_height_m, g.seed, None)?;
     if let (Some(f), Some(dir)) = (&file, cache_dir) {
         std::fs::create_dir_all(dir).map_err(|e| format!("bed cache {}: {e}", dir.display()))?;
         let tmp = f.with_extension(format!("tmp{}", std::process::id()));
@@ -78,13 +78,14 @@ pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<
     Ok(bed)
 }
 
-/// Pour and settle; `observe` sees the system after every step (tests use it).
+/// Pour and settle; `observe`, if given, sees the system after every step with the pair
+/// contacts' Coulomb excess measured (`DemSystem::set_audit`; tests use it).
 pub fn generate(
     case: &Case,
     count: Option<usize>,
     height: Option<f64>,
     seed: u64,
-    observe: &mut dyn FnMut(&DemSystem),
+    mut observe: Option<&mut dyn FnMut(&DemSystem)>,
 ) -> Result<(Vec<V3>, Vec<V3>), String> {
     let rt = case.column.diameter_m / 2.0;
     let area = std::f64::consts::PI * rt * rt;
@@ -100,7 +101,7 @@ pub fn generate(
     let e_floor = POUR_E_FLOOR_RHO_V2 * case.particles.density_kg_m3;
     let e_pour = (e_real / POUR_SOFTENING).max(e_floor).min(e_real);
     let mut sys = DemSystem::with_params(pour_params(case, e_pour, false), x, vec![[0.0; 3]; n]);
-    settle(&mut sys, POUR_SPEED, observe)?;
+    settle(&mut sys, POUR_SPEED, &mut observe)?;
     if let (None, Some(h)) = (count, height) {
         let r = case.particles.diameter_m / 2.0;
         let x = sys.positions();
@@ -122,14 +123,14 @@ pub fn generate(
         sys.set_params(p);
         // The last stage settles to the final threshold while still damped (the case's own
         // damping may be weak, e ≈ 0.97, and would ring for long).
-        settle(&mut sys, if last { RELAX_SPEED } else { POUR_SPEED }, observe)?;
+        settle(&mut sys, if last { RELAX_SPEED } else { POUR_SPEED }, &mut observe)?;
     }
     // Final relaxation with the case's own parameters.
     let mut p = DemParams::new(case);
     p.lid = false;
     p.work_chunks = BED_CHUNKS;
     sys.set_params(p);
-    settle(&mut sys, RELAX_SPEED, observe)?;
+    settle(&mut sys, RELAX_SPEED, &mut observe)?;
     Ok((sys.positions().to_vec(), sys.velocities().to_vec()))
 }
 
@@ -151,13 +152,16 @@ fn pour_params(case: &Case, e: f64, last: bool) -> DemParams {
 }
 
 /// Step until the mean kinetic energy per particle falls below ½ m `speed`², checked every 200 steps.
-fn settle(sys: &mut DemSystem, speed: f64, observe: &mut dyn FnMut(&DemSystem)) -> Result<(), String> {
+fn settle(sys: &mut DemSystem, speed: f64, observe: &mut Option<&mut dyn FnMut(&DemSystem)>) -> Result<(), String> {
+    sys.set_audit(observe.is_some());
     let dt = sys.params().dt;
     let limit = 0.5 * sys.params().mass * speed * speed * sys.len() as f64;
     let max_steps = (MAX_PHASE_TIME_S / dt) as u64;
     for s in 1..=max_steps {
         sys.step();
-        observe(sys);
+        if let Some(f) = observe.as_mut() {
+            f(sys);
+        }
         if s % 200 == 0 && sys.kinetic_energy() < limit {
             if std::env::var_os("FLUIDBED_POUR_TRACE").is_some() {
                 eprintln!("settle: {} particles, dt {:.3e}, {s} steps, {:.4} s", sys.len(), dt, s as f64 * dt);

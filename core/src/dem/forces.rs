@@ -103,11 +103,11 @@ pub fn pair_pass<const FR: bool>(
         work.push((a, b, sh, to, acc));
     }
     let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
-    let (law, h) = (&p.pair, p.dt);
+    let (law, h, audit) = (&p.pair, p.dt, p.audit);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
-            let args = ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
+            let args = ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
             match kernels {
                 Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
                 Kernels::Portable => chunk_pairs::<FR, false>(&args, sh, to, acc),
@@ -119,6 +119,8 @@ pub fn pair_pass<const FR: bool>(
 /// Read-only inputs of one chunk of the pair pass.
 pub(super) struct ChunkArgs<'a> {
     pub law: &'a ContactLaw,
+    /// Measure the Coulomb excess of every contact (`DemParams::audit`).
+    pub audit: bool,
     pub r: f64,
     pub h: f64,
     pub d2: f64,
@@ -168,7 +170,8 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &
 /// lanes hold indices into it (particle − a).
 #[inline(always)]
 fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
-    let &ChunkArgs { law, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
+    let &ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
+    let law = (law, audit);
     acc.fill(PairSum::default());
     let mut st = Stats::ZERO;
     let (base, end) = (offsets[a] as usize, offsets[b] as usize);
@@ -230,10 +233,10 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
-    batch: &mut Batch, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
+    batch: &mut Batch, (law, audit): (&ContactLaw, bool), r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
     acc: &mut [PairSum], st: &mut Stats,
 ) {
-    let (ov, ex) = batch.evaluate::<FR, V>(law, r, h, v, w, sh, base);
+    let (ov, ex) = batch.evaluate::<FR, V>(law, audit, r, h, v, w, sh, base);
     st.overlap = st.overlap.max(ov);
     st.coulomb_excess = st.coulomb_excess.max(ex);
     scatter::<FR, V>(batch, acc);

@@ -86,11 +86,11 @@ impl Batch {
 
     /// Evaluate every lane: fills `f` (and `c`, and the history `shear[k − base]` when FR; a lane
     /// with `was` = 0 starts from a zero history). Returns (max overlap, max (|F_t|² − (μF_n)²) /
-    /// (μF_n)²).
+    /// (μF_n)²), the second −∞ unless `audit`.
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn evaluate<const FR: bool, const V: bool>(
-        &mut self, law: &ContactLaw, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [Hist], base: usize,
+        &mut self, law: &ContactLaw, audit: bool, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [Hist], base: usize,
     ) -> (f64, f64) {
         let m = self.m.min(CAP);
         let n = v.len();
@@ -125,12 +125,17 @@ impl Batch {
                 }
             }
         }
-        lanes::<FR>(self, law, 2.0 * r, h);
+        let audit = FR && audit;
+        if audit {
+            lanes::<FR, true>(self, law, 2.0 * r, h);
+        } else {
+            lanes::<FR, false>(self, law, 2.0 * r, h);
+        }
         let max_delta = lane_max(m, 0.0f32, |l| self.delta[l]) as f64;
         if !FR {
             return (max_delta, f64::NEG_INFINITY);
         }
-        let max_excess = lane_max(m, f32::NEG_INFINITY, |l| self.excess[l]) as f64;
+        let max_excess = if audit { lane_max(m, f32::NEG_INFINITY, |l| self.excess[l]) as f64 } else { f64::NEG_INFINITY };
         let mut l0 = 0;
         #[cfg(target_arch = "x86_64")]
         if V {
@@ -182,7 +187,7 @@ impl Default for Box<Batch> {
 /// lanes, not eight"). All kernel variants do the same IEEE operations (no FMA), so they give
 /// the same bits.
 #[inline(always)]
-fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
+fn lanes<const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // Whole vectors of 16: the lanes past b.m hold scratch (zeros or older pairs) whose results
     // nobody reads. A count of b.m left the compiler a scalar tail of lanes per batch, each
     // several times the cost of a vector lane (docs/BENCHMARKS.md, "The lane loop's scalar tail").
@@ -232,9 +237,11 @@ fn lanes<const FR: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
             b.c[0][l] = n[1] * ft[2] - n[2] * ft[1];
             b.c[1][l] = n[2] * ft[0] - n[0] * ft[2];
             b.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
-            // Relative, in the lanes (a division per lane in double had cost 2% of a step).
-            let lim2 = lim * lim;
-            b.excess[l] = (ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim2) / lim2.max(f32::MIN_POSITIVE);
+            if AUDIT {
+                // Relative, in the lanes (a division per lane in double had cost 2% of a step).
+                let lim2 = lim * lim;
+                b.excess[l] = (ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim2) / lim2.max(f32::MIN_POSITIVE);
+            }
         }
         for (q, fq) in f.into_iter().enumerate() {
             b.f[q][l] = fq;

@@ -176,7 +176,7 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
-                let args = ChunkArgs { law: &p.pair, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
+                let args = ChunkArgs { law: &p.pair, audit: p.audit, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
                 #[cfg(test)]
                 assert!(PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1 || has_own_team(), "injected panic in chunk {c}");
                 st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));

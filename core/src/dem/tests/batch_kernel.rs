@@ -60,11 +60,11 @@ fn batch_against_scalar_law(n: usize) {
     if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("bmi2") {
         let mut b2 = filled();
         let mut shear = shear0.clone();
-        let maxima = b2.evaluate::<true, true>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
+        let maxima = b2.evaluate::<true, true>(&p.pair, true, r, p.dt, &v, &w, &mut shear, 0);
         vector = Some((b2, shear, maxima));
     }
     let mut shear = shear0.clone();
-    let maxima = batch.evaluate::<true, false>(&p.pair, r, p.dt, &v, &w, &mut shear, 0);
+    let maxima = batch.evaluate::<true, false>(&p.pair, true, r, p.dt, &v, &w, &mut shear, 0);
     if let Some((b2, s2, m2)) = &vector {
         // the AVX-512 gather (`pair_simd::gather8`) gives the same lanes as the portable one
         let valid = |a: &[[f32; CAP]; 3]| a.map(|q| q[..n].to_vec());
@@ -148,7 +148,8 @@ fn vector_pair_pass_equals_the_portable_one() {
         *s = [1e-6 * rng.gen::<f32>(), -1e-6 * rng.gen::<f32>(), 1e-7];
         *t = rng.gen::<bool>() as u8;
     }
-    let p = sys.p.clone();
+    let mut p = sys.p.clone();
+    p.audit = true;
     let run = |kernels: Kernels| {
         let mut nl = sys.near.list.clone();
         let mut sc = Scratch::plan(&nl, sys.x.len(), 3);
@@ -168,4 +169,14 @@ fn vector_pair_pass_equals_the_portable_one() {
     assert_eq!(first_diff(bits(&portable.2), bits(&vector.2)), None, "forces and torques (first differing value)");
     let bits3 = |a: &[[f32; 3]]| a.iter().flatten().map(|f| f.to_bits() as u64).collect::<Vec<_>>();
     assert_eq!(first_diff(bits3(&portable.4), bits3(&vector.4)), None, "histories (first differing value)");
+    // Without the audit the pair pass skips the Coulomb diagnostic and nothing else.
+    let mut nl = sys.near.list.clone();
+    let mut sc = Scratch::plan(&nl, sys.x.len(), 3);
+    p.audit = false;
+    let st = pair_pass::<true>(&p, &sys.x, &sys.v, &sys.w, &mut nl, &mut sc, Kernels::Best);
+    assert_eq!(st.coulomb_excess, f64::NEG_INFINITY, "no diagnostic without the audit");
+    assert_eq!(st.overlap.to_bits(), vector.0.to_bits(), "largest overlap without the audit");
+    assert_eq!(first_diff(bits(&sc.acc), bits(&vector.2)), None, "forces without the audit");
+    assert_eq!(first_diff(bits3(&nl.shear), bits3(&vector.4)), None, "histories without the audit");
+    assert!(nl.touch == vector.3, "contact flags without the audit");
 }

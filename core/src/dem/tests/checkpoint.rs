@@ -11,7 +11,9 @@ pub(super) fn busy_system() -> DemSystem {
     let case = with_damping(test_case(0.012, 0.03, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
     let r = case.particles.diameter_m / 2.0;
     let (x, v) = random_gas(600, 0.006, 0.03, r, 0.6, 11);
-    DemSystem::new(&case, x, v)
+    let mut s = DemSystem::new(&case, x, v);
+    s.set_audit(true); // the Coulomb diagnostic counts the frictional steps
+    s
 }
 
 /// The system after `steps` steps, and how many steps had frictional contacts.
@@ -67,4 +69,19 @@ fn checkpoint_round_trip_continues_identically() {
     // A JSON round trip keeps the state to round-off.
     let json: DemSystem = serde_json::from_str(&serde_json::to_string(&half).unwrap()).unwrap();
     assert!(json.positions().iter().zip(half.positions()).all(|(p, q)| (0..3).all(|k| (p[k] - q[k]).abs() <= 1e-15)));
+}
+
+#[test]
+fn the_coulomb_audit_leaves_the_trajectory_unchanged() {
+    let audited = run_in_pool(2, 1500);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    let plain = pool.install(|| {
+        let mut s = busy_system();
+        s.set_audit(false);
+        for _ in 0..1500 {
+            s.step();
+        }
+        s
+    });
+    assert!(same_state(&audited, &plain), "the audit changed the trajectory");
 }

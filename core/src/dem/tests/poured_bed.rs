@@ -4,6 +4,7 @@
 
 use super::test_case;
 use crate::dem::bed::{build_bed, cache_key, generate};
+use crate::dem::DemSystem;
 
 /// Solid fraction inside r < r_max, z0 < z < z1 by sampling a regular lattice of points.
 fn solid_fraction(x: &[[f64; 3]], r: f64, r_max: f64, z0: f64, z1: f64) -> f64 {
@@ -65,13 +66,13 @@ fn poured_bed_stays_in_the_column_and_packs_randomly() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let (x, _) = pool
         .install(|| {
-            generate(&case, Some(2500), None, 5, &mut |s| {
+            generate(&case, Some(2500), None, 5, Some(&mut |s: &DemSystem| {
                 for p in s.positions() {
                     let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
                     worst_wall = worst_wall.max(rho - rt).max(-p[2]);
                 }
                 worst_coulomb = worst_coulomb.max(s.max_coulomb_excess());
-            })
+            }))
         })
         .unwrap();
     assert_eq!(x.len(), 2500);
@@ -110,7 +111,7 @@ fn settled_height_mode_fills_the_column_to_the_requested_height() {
     let d = case.particles.diameter_m;
     let (r, rt, h) = (d / 2.0, case.column.diameter_m / 2.0, 0.008);
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
-    let (x, _) = pool.install(|| generate(&case, None, Some(h), 3, &mut |_| {})).unwrap();
+    let (x, _) = pool.install(|| generate(&case, None, Some(h), 3, None)).unwrap();
     let top = x.iter().map(|p| p[2] + r).fold(0.0, f64::max);
     assert!((top - h).abs() <= d, "bed top {top} m, requested {h} m");
     // A full column: the count is near φ π R_t² H / V_p for a random packing (φ ≈ 0.6).
