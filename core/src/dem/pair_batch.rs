@@ -185,7 +185,7 @@ impl Default for Box<Batch> {
 /// Every array the loop reads or writes is single precision: with double arrays in the loop the
 /// compiler sized its vectors by them (eight lanes per step); now it takes sixteen ("Sixteen
 /// lanes, not eight"). All kernel variants do the same IEEE operations (no FMA), so they give
-/// the same bits.
+/// the same bits. AUDIT also fills each lane's Coulomb excess (a division; tests only).
 #[inline(always)]
 fn lanes<const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // Whole vectors of 16: the lanes past b.m hold scratch (zeros or older pairs) whose results
