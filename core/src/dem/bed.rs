@@ -78,7 +78,7 @@ pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<
     Ok(bed)
 }
 
-/// Pour and settle; `observe`, if given, sees the system after every step with the pair
+/// Pour and settle; `observe`, if given, sees the system after every step with the
 /// contacts' Coulomb excess measured (`DemSystem::set_audit`; tests use it).
 pub fn generate(
     case: &Case,

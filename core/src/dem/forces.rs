@@ -171,7 +171,6 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &
 #[inline(always)]
 fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
     let &ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
-    let law = (law, audit);
     acc.fill(PairSum::default());
     let mut st = Stats::ZERO;
     let (base, end) = (offsets[a] as usize, offsets[b] as usize);
@@ -188,7 +187,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
         while k + LANES <= end {
             if m > CAP - LANES {
                 batch.m = m;
-                flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
+                flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
                 m = 0;
             }
             // SAFETY: V is set only by the caller compiled for (and checked to have) the
@@ -198,7 +197,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
         }
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
+            flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
             m = 0;
         }
     }
@@ -220,12 +219,12 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
         m += touching as usize;
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
+            flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
             m = 0;
         }
     }
     batch.m = m;
-    flush::<FR, V>(&mut batch, law, r, h, v, w, sh, base, acc, &mut st);
+    flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
     st
 }
 
@@ -233,7 +232,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
-    batch: &mut Batch, (law, audit): (&ContactLaw, bool), r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
+    batch: &mut Batch, law: &ContactLaw, audit: bool, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
     acc: &mut [PairSum], st: &mut Stats,
 ) {
     let (ov, ex) = batch.evaluate::<FR, V>(law, audit, r, h, v, w, sh, base);

@@ -71,8 +71,8 @@ pub struct DemParams {
     /// Work chunks of the pair pass; 0 = twice the pool's threads. The summation order follows
     /// the chunks, so a fixed value makes results independent of the thread count.
     pub work_chunks: usize,
-    /// Measure every pair contact's Coulomb excess (`DemSystem::max_coulomb_excess`), a check
-    /// for tests; off, the pair pass skips it (2–3% of a step) and the trajectory is the same.
+    /// Measure every contact's Coulomb excess (`DemSystem::max_coulomb_excess`), a check for
+    /// tests; off, the passes skip it (2–3% of a step) and the trajectory is the same.
     #[serde(default)]
     pub audit: bool,
 }

@@ -226,14 +226,13 @@ impl DemSystem {
 
     /// Largest (|F_t|² − (μ F_n)²) / (μ F_n)² over all contacts in the last step (≤ round-off
     /// when the Coulomb limit holds: ~1e-16 for walls, ~1e-6 for the single-precision pair law;
-    /// −∞ without frictional contacts). Wall contacts always; pair contacts only with
-    /// `set_audit(true)`. For tests and diagnostics.
+    /// −∞ without frictional contacts, and unless `set_audit(true)`). For tests and diagnostics.
     pub fn max_coulomb_excess(&self) -> f64 {
         self.last.1
     }
 
-    /// Measure the pair contacts' Coulomb excess from the next step on (`DemParams::audit`);
-    /// the trajectory is the same either way.
+    /// Measure the contacts' Coulomb excess from the next step on (`DemParams::audit`); the
+    /// trajectory is the same either way.
     pub fn set_audit(&mut self, on: bool) {
         self.p.audit = on;
     }

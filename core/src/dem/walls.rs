@@ -51,11 +51,12 @@ impl WallList {
 }
 
 /// One wall contact: overlap `delta` along the outward normal `nrm`; hands wall `k`'s force and
-/// n × F_t to `on`. Returns (overlap, Coulomb excess) for the diagnostics.
+/// n × F_t to `on`. Returns (overlap, Coulomb excess, −∞ unless `audit`) for the diagnostics.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn wall_contact<const FR: bool>(
-    law: &ContactLaw, r: f64, h: f64, k: usize, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3, on: &mut impl FnMut(usize, &[f64; 6]),
+    law: &ContactLaw, audit: bool, r: f64, h: f64, k: usize, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3,
+    on: &mut impl FnMut(usize, &[f64; 6]),
 ) -> (f64, f64) {
     if delta <= 0.0 {
         *hist = [0.0; 3];
@@ -64,30 +65,30 @@ fn wall_contact<const FR: bool>(
     let ws = [r * wi[0], r * wi[1], r * wi[2]];
     let cf = contact_force::<FR>(law, delta, nrm, vi, ws, hist, h);
     on(k, &[cf.f[0], cf.f[1], cf.f[2], cf.c[0], cf.c[1], cf.c[2]]);
-    (delta, if FR { cf.excess } else { f64::NEG_INFINITY })
+    (delta, if FR && audit { cf.excess } else { f64::NEG_INFINITY })
 }
 
 /// Every wall contact of a particle at `xi`: wall k (0 plate, 1 tube, 2 lid) hands its force
 /// and n × F_t to `on`; returns the largest overlap and Coulomb excess.
 #[inline(always)]
 fn each_wall<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], mut on: impl FnMut(usize, &[f64; 6])) -> (f64, f64) {
-    let (law, r, h) = (&p.wall, p.radius, p.dt);
+    let (law, audit, r, h) = (&p.wall, p.audit, p.radius, p.dt);
     let [h0, h1, h2] = hist;
     // Distributor plate z = 0: normal (0,0,−1).
-    let (mut ov, mut ex) = wall_contact::<FR>(law, r, h, 0, r - xi[2], [0.0, 0.0, -1.0], vi, wi, h0, &mut on);
+    let (mut ov, mut ex) = wall_contact::<FR>(law, audit, r, h, 0, r - xi[2], [0.0, 0.0, -1.0], vi, wi, h0, &mut on);
     // Tube of radius R_t: outward radial normal.
     let rho2 = xi[0] * xi[0] + xi[1] * xi[1];
     let reach = p.tube_radius - r;
     if rho2 > reach * reach {
         let rho = rho2.sqrt();
         let nrm = [xi[0] / rho, xi[1] / rho, 0.0];
-        let (o, e) = wall_contact::<FR>(law, r, h, 1, rho - reach, nrm, vi, wi, h1, &mut on);
+        let (o, e) = wall_contact::<FR>(law, audit, r, h, 1, rho - reach, nrm, vi, wi, h1, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     } else {
         *h1 = [0.0; 3];
     }
     if p.lid {
-        let (o, e) = wall_contact::<FR>(law, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
+        let (o, e) = wall_contact::<FR>(law, audit, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     }
     (ov, ex)
