@@ -76,7 +76,13 @@ impl Api {
 
     /// Submit a case (JSON text); the created job.
     pub async fn submit(&self, case_json: &str) -> Result<Value, ApiError> {
-        let r = self.http.post(self.url("/v1/jobs")).header(header::CONTENT_TYPE, "application/json").body(case_json.to_string()).send().await;
+        let r = self
+            .http
+            .post(self.url("/v1/jobs"))
+            .header(header::CONTENT_TYPE, "application/json")
+            .body(case_json.to_string())
+            .send()
+            .await;
         let r = Self::check(r).await?;
         r.json().await.map_err(|e| ApiError::Server(format!("bad JSON from server: {e}")))
     }

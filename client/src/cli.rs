@@ -101,7 +101,13 @@ pub(crate) fn api_fail(e: ApiError, json_out: bool) -> i32 {
                 println!("{p}");
             } else {
                 for err in p["errors"].as_array().into_iter().flatten() {
-                    eprintln!("error: {}: {} (got {}; allowed: {})", err["pointer"].as_str().unwrap_or(""), err["message"].as_str().unwrap_or(""), err["value"], err["allowed"].as_str().unwrap_or(""));
+                    eprintln!(
+                        "error: {}: {} (got {}; allowed: {})",
+                        err["pointer"].as_str().unwrap_or(""),
+                        err["message"].as_str().unwrap_or(""),
+                        err["value"],
+                        err["allowed"].as_str().unwrap_or("")
+                    );
                 }
             }
             exit::INVALID_CASE
@@ -244,7 +250,9 @@ async fn dispatch(cli: Cli) -> i32 {
             }
             Err(e) => api_fail(e, j),
         },
-        Verb::Run { case, out, formats, threads } => crate::cli_run::run(cli.server.is_some().then_some(api), token, case, out, formats, threads, j).await,
+        Verb::Run { case, out, formats, threads } => {
+            crate::cli_run::run(cli.server.is_some().then_some(api), token, case, out, formats, threads, j).await
+        }
     }
 }
 
@@ -256,4 +264,3 @@ pub(crate) fn report_outcome(id: &str, status: &str, message: Option<&str>, json
         eprintln!("job {id} {status}{m}");
     }
 }
-

@@ -10,7 +10,15 @@ use crate::watch::watch;
 use serde_json::json;
 use std::path::PathBuf;
 
-pub async fn run(server: Option<Api>, token: Option<String>, case: PathBuf, out: Option<PathBuf>, formats: String, threads: Option<usize>, json_out: bool) -> i32 {
+pub async fn run(
+    server: Option<Api>,
+    token: Option<String>,
+    case: PathBuf,
+    out: Option<PathBuf>,
+    formats: String,
+    threads: Option<usize>,
+    json_out: bool,
+) -> i32 {
     let formats = match Formats::parse(&formats) {
         Ok(f) => f,
         Err(m) => return fail(exit::USAGE, &m),
@@ -59,7 +67,10 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
     };
     report_outcome(&id, &outcome.status, outcome.message.as_deref(), false);
     if json_out {
-        println!("{}", json!({ "id": id, "status": outcome.status, "message": outcome.message, "out": out, "files": files }));
+        println!(
+            "{}",
+            json!({ "id": id, "status": outcome.status, "message": outcome.message, "out": out, "files": files })
+        );
     } else {
         eprintln!("fluidbed: {} files in {}", files.len(), out.display());
     }
@@ -72,21 +83,31 @@ type Embedded = fluidbed_server::Server;
 type Embedded = ();
 
 #[cfg(feature = "embedded")]
-fn start_embedded(out: &std::path::Path, threads: Option<usize>, token: Option<&str>) -> Result<(Api, Option<Embedded>), i32> {
+fn start_embedded(
+    out: &std::path::Path,
+    threads: Option<usize>,
+    token: Option<&str>,
+) -> Result<(Api, Option<Embedded>), i32> {
     let data = out.join("server-data");
     if data.exists() {
-        std::fs::remove_dir_all(&data).map_err(|e| fail(exit::SERVER, &format!("cannot clear {}: {e}", data.display())))?;
+        std::fs::remove_dir_all(&data)
+            .map_err(|e| fail(exit::SERVER, &format!("cannot clear {}: {e}", data.display())))?;
     }
     let mut cfg = fluidbed_server::Config::new(data);
     cfg.listen = std::net::SocketAddr::from(([127, 0, 0, 1], 0));
     cfg.threads_per_job = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
     cfg.token = token.map(str::to_string);
-    let server = fluidbed_server::Server::start(cfg).map_err(|e| fail(exit::SERVER, &format!("cannot start the embedded server: {e:#}")))?;
+    let server = fluidbed_server::Server::start(cfg)
+        .map_err(|e| fail(exit::SERVER, &format!("cannot start the embedded server: {e:#}")))?;
     let api = Api::new(&server.url(), token).map_err(|e| fail(exit::SERVER, &e.to_string()))?;
     Ok((api, Some(server)))
 }
 
 #[cfg(not(feature = "embedded"))]
-fn start_embedded(_out: &std::path::Path, _threads: Option<usize>, _token: Option<&str>) -> Result<(Api, Option<Embedded>), i32> {
+fn start_embedded(
+    _out: &std::path::Path,
+    _threads: Option<usize>,
+    _token: Option<&str>,
+) -> Result<(Api, Option<Embedded>), i32> {
     Err(fail(exit::USAGE, "this build has no embedded server (feature `embedded`): pass --server URL"))
 }

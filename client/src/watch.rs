@@ -128,7 +128,12 @@ impl Bar {
                 self.dp = d["pressure_drop_pa"].as_f64().or(self.dp);
                 self.height = d["mean_particle_height_m"].as_f64().or(self.height);
                 if !self.tty {
-                    eprintln!("snapshot {} at t = {:.4} s{}", d["n"], d["time_s"].as_f64().unwrap_or(0.0), self.latest());
+                    eprintln!(
+                        "snapshot {} at t = {:.4} s{}",
+                        d["n"],
+                        d["time_s"].as_f64().unwrap_or(0.0),
+                        self.latest()
+                    );
                 }
             }
             "progress" if self.tty => {

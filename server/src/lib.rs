@@ -120,10 +120,15 @@ impl Server {
                 app.queue.push(id);
             }
         }
-        let listener = std::net::TcpListener::bind(app.config.listen).with_context(|| format!("bind {}", app.config.listen))?;
+        let listener =
+            std::net::TcpListener::bind(app.config.listen).with_context(|| format!("bind {}", app.config.listen))?;
         listener.set_nonblocking(true)?;
         let addr = listener.local_addr()?;
-        let runtime = tokio::runtime::Builder::new_multi_thread().worker_threads(2).thread_name("fluidbed-http").enable_all().build()?;
+        let runtime = tokio::runtime::Builder::new_multi_thread()
+            .worker_threads(2)
+            .thread_name("fluidbed-http")
+            .enable_all()
+            .build()?;
         let (shutdown_tx, shutdown_rx) = tokio::sync::oneshot::channel::<()>();
         let router = api::router(app.clone());
         runtime.spawn(async move {

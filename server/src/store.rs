@@ -129,25 +129,35 @@ impl Store {
         let filter = if status.is_some() { "WHERE status = ?1" } else { "WHERE ?1 IS NULL" };
         let st = status.map(|s| s.as_str());
         let sql = format!("SELECT {JOB_COLUMNS} FROM jobs {filter} ORDER BY seq DESC LIMIT ?2 OFFSET ?3");
-        let jobs = db.prepare(&sql)?.query_map(params![st, limit as i64, offset as i64], job_of)?.collect::<Result<Vec<_>, _>>()?;
+        let jobs = db
+            .prepare(&sql)?
+            .query_map(params![st, limit as i64, offset as i64], job_of)?
+            .collect::<Result<Vec<_>, _>>()?;
         let total: i64 = db.query_row(&format!("SELECT COUNT(*) FROM jobs {filter}"), params![st], |r| r.get(0))?;
         Ok((jobs, total as usize))
     }
 
     pub fn count(&self, status: Status) -> Result<usize> {
-        let n: i64 = self.db().query_row("SELECT COUNT(*) FROM jobs WHERE status = ?1", [status.as_str()], |r| r.get(0))?;
+        let n: i64 =
+            self.db().query_row("SELECT COUNT(*) FROM jobs WHERE status = ?1", [status.as_str()], |r| r.get(0))?;
         Ok(n as usize)
     }
 
     /// Ids with this status, oldest first.
     pub fn ids_with(&self, status: Status) -> Result<Vec<String>> {
         let db = self.db();
-        let ids = db.prepare("SELECT id FROM jobs WHERE status = ?1 ORDER BY seq")?.query_map([status.as_str()], |r| r.get(0))?.collect::<Result<Vec<String>, _>>()?;
+        let ids = db
+            .prepare("SELECT id FROM jobs WHERE status = ?1 ORDER BY seq")?
+            .query_map([status.as_str()], |r| r.get(0))?
+            .collect::<Result<Vec<String>, _>>()?;
         Ok(ids)
     }
 
     pub fn set_running(&self, id: &str, now: &str) -> Result<()> {
-        self.db().execute("UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, ?2) WHERE id = ?1", params![id, now])?;
+        self.db().execute(
+            "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, ?2) WHERE id = ?1",
+            params![id, now],
+        )?;
         Ok(())
     }
 
@@ -162,7 +172,15 @@ impl Store {
         Ok(())
     }
 
-    pub fn set_progress(&self, id: &str, time_s: f64, end_time_s: f64, steps: u64, wall_s: f64, eta_s: Option<f64>) -> Result<()> {
+    pub fn set_progress(
+        &self,
+        id: &str,
+        time_s: f64,
+        end_time_s: f64,
+        steps: u64,
+        wall_s: f64,
+        eta_s: Option<f64>,
+    ) -> Result<()> {
         self.db().execute(
             "UPDATE jobs SET time_s = ?2, end_time_s = ?3, steps = ?4, wall_s = ?5, eta_s = ?6 WHERE id = ?1",
             params![id, time_s, end_time_s, steps as i64, wall_s, eta_s],

@@ -75,7 +75,10 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
 }
 
 fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
-    p.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| p.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into())
+    p.downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| p.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
 }
 
 fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {

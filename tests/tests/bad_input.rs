@@ -50,14 +50,24 @@ async fn bad_requests_are_refused_with_problem_details_and_leave_nothing_behind(
     let url = format!("{base}{}", r.headers()["location"].to_str().unwrap());
     wait_final(&http, &url, std::time::Duration::from_secs(120)).await;
     for name in ["..%2F..%2Ffluidbed.sqlite", "..", "0%2F..%2F1", "-1", "1e3"] {
-        assert_eq!(http.get(format!("{url}/snapshots/{name}?format=npy")).send().await.unwrap().status(), 404, "{name}");
+        assert_eq!(
+            http.get(format!("{url}/snapshots/{name}?format=npy")).send().await.unwrap().status(),
+            404,
+            "{name}"
+        );
     }
     server.shutdown();
     // Only the accepted job added files: no folder or file from the refused requests.
     let id = url.rsplit('/').next().unwrap();
     let added: Vec<_> = files_under(dir.path()).into_iter().filter(|p| !before.contains(p)).collect();
-    assert!(added.iter().all(|p| p.starts_with(format!("jobs/{id}")) || p.starts_with("cache") || p.to_string_lossy().starts_with("fluidbed.sqlite")), "{added:?}");
-    let jobs_dirs: Vec<_> = std::fs::read_dir(dir.path().join("jobs")).unwrap().flatten().map(|e| e.file_name()).collect();
+    assert!(
+        added.iter().all(|p| p.starts_with(format!("jobs/{id}"))
+            || p.starts_with("cache")
+            || p.to_string_lossy().starts_with("fluidbed.sqlite")),
+        "{added:?}"
+    );
+    let jobs_dirs: Vec<_> =
+        std::fs::read_dir(dir.path().join("jobs")).unwrap().flatten().map(|e| e.file_name()).collect();
     assert_eq!(jobs_dirs.len(), 1);
 }
 
@@ -76,7 +86,8 @@ async fn a_token_guards_every_route_but_healthz() {
     let r = http.post(format!("{base}/v1/jobs")).json(&lattice_case(2, 1, 0.004, 0.002)).send().await.unwrap();
     assert_eq!(r.status(), 401);
     assert_eq!(http.get(format!("{base}/v1/jobs")).bearer_auth("s3cret").send().await.unwrap().status(), 200);
-    let listed: Value = http.get(format!("{base}/v1/jobs")).bearer_auth("s3cret").send().await.unwrap().json().await.unwrap();
+    let listed: Value =
+        http.get(format!("{base}/v1/jobs")).bearer_auth("s3cret").send().await.unwrap().json().await.unwrap();
     assert_eq!(listed["total"], 0, "the refused POST created no job");
     server.shutdown();
 }

@@ -31,7 +31,9 @@ async fn a_job_says_it_is_preparing_its_bed_while_pouring() {
             assert_eq!(j["steps"], 0, "the message belongs to the preparation: {j}");
             preparing_seen = true;
         }
-        if matches!(j["status"].as_str(), Some("succeeded" | "failed" | "cancelled")) || t0.elapsed() > Duration::from_secs(120) {
+        if matches!(j["status"].as_str(), Some("succeeded" | "failed" | "cancelled"))
+            || t0.elapsed() > Duration::from_secs(120)
+        {
             break j;
         }
         tokio::time::sleep(Duration::from_millis(10)).await;

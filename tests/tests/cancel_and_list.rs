@@ -44,8 +44,12 @@ async fn cancelled_job_stops_early_and_listing_filters_and_pages() {
     let ids: Vec<&str> = all["jobs"].as_array().unwrap().iter().map(|j| j["id"].as_str().unwrap()).collect();
     assert_eq!(ids, [url2.rsplit('/').next().unwrap(), url.rsplit('/').next().unwrap()]);
     let page: Value = http.get(format!("{base}/v1/jobs?limit=1")).send().await.unwrap().json().await.unwrap();
-    assert_eq!((page["jobs"].as_array().unwrap().len(), page["total"].as_u64(), page["next_offset"].as_u64()), (1, Some(2), Some(1)));
-    let cancelled: Value = http.get(format!("{base}/v1/jobs?status=cancelled")).send().await.unwrap().json().await.unwrap();
+    assert_eq!(
+        (page["jobs"].as_array().unwrap().len(), page["total"].as_u64(), page["next_offset"].as_u64()),
+        (1, Some(2), Some(1))
+    );
+    let cancelled: Value =
+        http.get(format!("{base}/v1/jobs?status=cancelled")).send().await.unwrap().json().await.unwrap();
     assert_eq!(cancelled["total"], 1);
     assert_eq!(cancelled["jobs"][0]["status"], "cancelled");
     assert_eq!(http.get(format!("{base}/v1/jobs?status=bogus")).send().await.unwrap().status(), 400);

@@ -9,11 +9,27 @@ fn run_with_embedded_server_leaves_csv_npy_vtk_and_png() {
     let case = dir.path().join("tiny.json");
     std::fs::write(&case, lattice_case(3, 2, 0.01, 0.005).to_string()).unwrap();
     let out = dir.path().join("out");
-    let code = fluidbed::cli::main_with(["fluidbed", "run", case.to_str().unwrap(), "--out", out.to_str().unwrap(), "--threads", "1"]);
+    let code = fluidbed::cli::main_with([
+        "fluidbed",
+        "run",
+        case.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+        "--threads",
+        "1",
+    ]);
     assert_eq!(code, fluidbed::exit::OK);
     let csv = std::fs::read_to_string(out.join("pressure_drop.csv")).unwrap();
     assert_eq!(csv.lines().count(), 1 + 3, "header and one row per snapshot");
-    for f in ["voidage_000000.npy", "voidage_000002.npy", "cells_000002.vtk", "particles_000002.vtk", "cells.pvd", "voidage_last.png", "mean_particle_height.png"] {
+    for f in [
+        "voidage_000000.npy",
+        "voidage_000002.npy",
+        "cells_000002.vtk",
+        "particles_000002.vtk",
+        "cells.pvd",
+        "voidage_last.png",
+        "mean_particle_height.png",
+    ] {
         assert!(out.join(f).is_file(), "{f} written");
     }
     let png = std::fs::read(out.join("voidage_last.png")).unwrap();

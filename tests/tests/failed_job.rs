@@ -21,7 +21,11 @@ async fn an_unstable_run_fails_with_the_watchdog_message() {
     assert!(!job["message"].as_str().unwrap_or("").is_empty(), "the failure says why: {job}");
     let base = server.url();
     let id = url.rsplit('/').next().unwrap().to_string();
-    let code = tokio::task::spawn_blocking(move || fluidbed::cli::main_with(["fluidbed", "--server", base.as_str(), "watch", id.as_str()])).await.unwrap();
+    let code = tokio::task::spawn_blocking(move || {
+        fluidbed::cli::main_with(["fluidbed", "--server", base.as_str(), "watch", id.as_str()])
+    })
+    .await
+    .unwrap();
     assert_eq!(code, fluidbed::exit::JOB_FAILED);
     server.shutdown();
 }

@@ -64,7 +64,8 @@ async fn submitted_case_streams_events_and_every_download_checks_out() {
         let (shape, eps) = npy::decode_f64(&bytes).expect("valid npy");
         assert_eq!(shape.len(), 2);
         assert!(eps.iter().all(|e| (0.0..=1.0).contains(e)), "voidage within [0, 1]");
-        let js: Value = http.get(format!("{url}/snapshots/{n}?format=json")).send().await.unwrap().json().await.unwrap();
+        let js: Value =
+            http.get(format!("{url}/snapshots/{n}?format=json")).send().await.unwrap().json().await.unwrap();
         let vc = js["grid"]["cell_volume_m3"].as_f64().unwrap();
         assert_eq!(shape[0] * shape[1], js["grid"]["num_cells"].as_u64().unwrap() as usize);
         let solid: f64 = eps.iter().map(|e| (1.0 - e) * vc).sum();
@@ -76,9 +77,23 @@ async fn submitted_case_streams_events_and_every_download_checks_out() {
         let vtk = http.get(format!("{url}/snapshots/{n}?format=vtk")).send().await.unwrap().text().await.unwrap();
         assert!(vtk.starts_with("# vtk DataFile") && vtk.contains("DATASET UNSTRUCTURED_GRID"));
         assert!(vtk.contains("SCALARS voidage double 1"));
-        let pv = http.get(format!("{url}/snapshots/{n}?format=vtk&what=particles")).send().await.unwrap().text().await.unwrap();
+        let pv = http
+            .get(format!("{url}/snapshots/{n}?format=vtk&what=particles"))
+            .send()
+            .await
+            .unwrap()
+            .text()
+            .await
+            .unwrap();
         assert!(pv.contains(&format!("POINTS {n_particles} double")) && pv.contains("VECTORS velocity_m_s double"));
-        let pn = http.get(format!("{url}/snapshots/{n}?format=npy&field=particles")).send().await.unwrap().bytes().await.unwrap();
+        let pn = http
+            .get(format!("{url}/snapshots/{n}?format=npy&field=particles"))
+            .send()
+            .await
+            .unwrap()
+            .bytes()
+            .await
+            .unwrap();
         assert_eq!(npy::decode_f64(&pn).unwrap().0, vec![n_particles, 6]);
     }
 

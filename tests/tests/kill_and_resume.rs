@@ -10,7 +10,14 @@ async fn final_particles(http: &reqwest::Client, url: &str) -> (usize, Vec<f64>)
     let list: Value = http.get(format!("{url}/snapshots")).send().await.unwrap().json().await.unwrap();
     let snaps = list["snapshots"].as_array().unwrap();
     let last = snaps.last().unwrap()["n"].as_u64().unwrap();
-    let b = http.get(format!("{url}/snapshots/{last}?format=npy&field=particles")).send().await.unwrap().bytes().await.unwrap();
+    let b = http
+        .get(format!("{url}/snapshots/{last}?format=npy&field=particles"))
+        .send()
+        .await
+        .unwrap()
+        .bytes()
+        .await
+        .unwrap();
     (snaps.len(), npy::decode_f64(&b).expect("particles npy").1)
 }
 

@@ -32,7 +32,8 @@ fn bench_case() -> Case {
 
 /// Positions from the LAMMPS data file (columns id type diameter density x y z), in id order.
 fn load_anchor() -> Option<Vec<[f64; 3]>> {
-    let candidates = [ANCHOR.to_string(), format!("{}/../../shared/anchors/settled_25000.data.gz", env!("CARGO_MANIFEST_DIR"))];
+    let candidates =
+        [ANCHOR.to_string(), format!("{}/../../shared/anchors/settled_25000.data.gz", env!("CARGO_MANIFEST_DIR"))];
     let path = candidates.iter().find(|p| std::path::Path::new(p).exists())?;
     let out = std::process::Command::new("zcat").arg(path).output().ok()?;
     let text = String::from_utf8(out.stdout).ok()?;

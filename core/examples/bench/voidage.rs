@@ -6,24 +6,27 @@
 //! per layer (converged; checked against lattice sampling in the unit tests).
 
 use fluidbed_core::case::BoxSplit;
-use fluidbed_core::coupling::voidage::{voidage_from_solid, Direct, ExactCylindrical, Grouping, SquareGrid, VoidageMethod};
+use fluidbed_core::coupling::voidage::{
+    voidage_from_solid, Direct, ExactCylindrical, Grouping, SquareGrid, VoidageMethod,
+};
 use fluidbed_core::grid::CylGrid;
 use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 use std::time::Instant;
 
 fn methods(g: &CylGrid) -> Vec<(String, Box<dyn VoidageMethod>)> {
-    let mut m: Vec<(String, Box<dyn VoidageMethod>)> = vec![
-        ("direct".into(), Box::new(Direct::new(g))),
-        ("grouping".into(), Box::new(Grouping::new(g))),
-    ];
+    let mut m: Vec<(String, Box<dyn VoidageMethod>)> =
+        vec![("direct".into(), Box::new(Direct::new(g))), ("grouping".into(), Box::new(Grouping::new(g)))];
     for (split, tag) in [(BoxSplit::Cuboid, "cuboid"), (BoxSplit::Exact, "exact")] {
         for (c, dl) in [4.4e-3, 2.2e-3, 1.375e-3].iter().enumerate() {
             m.push((format!("square_grid {tag} config {}", c + 1), Box::new(SquareGrid::new(g, *dl, split, 1.0))));
         }
     }
     let h_eq = (PI / 6.0f64).powf(1.0 / 3.0);
-    m.push(("square_grid cuboid config 3, h = 0.806 d".into(), Box::new(SquareGrid::new(g, 1.375e-3, BoxSplit::Cuboid, h_eq))));
+    m.push((
+        "square_grid cuboid config 3, h = 0.806 d".into(),
+        Box::new(SquareGrid::new(g, 1.375e-3, BoxSplit::Cuboid, h_eq)),
+    ));
     for n in [2, 3, 4, 6] {
         m.push((format!("exact_cylindrical {n} nodes"), Box::new(ExactCylindrical::with_nodes(g, n))));
     }
@@ -58,7 +61,11 @@ pub fn run() {
         ExactCylindrical::with_nodes(&g, 48).solid_volume(&pos, a, &mut solid);
         voidage_from_solid(&g, &solid, &mut eps_ref);
         let mean: f64 = eps_ref.iter().sum::<f64>() / eps_ref.len() as f64;
-        eprintln!("ε = {target}: {} particles, mean voidage {mean:.3}, reference {:.1} s", pos.len(), t.elapsed().as_secs_f64());
+        eprintln!(
+            "ε = {target}: {} particles, mean voidage {mean:.3}, reference {:.1} s",
+            pos.len(),
+            t.elapsed().as_secs_f64()
+        );
         for (k, (name, mut m)) in methods(&g).into_iter().enumerate() {
             m.solid_volume(&pos, a, &mut solid);
             voidage_from_solid(&g, &solid, &mut eps);
@@ -71,7 +78,10 @@ pub fn run() {
                 reps += 1;
             }
             let ns = t.elapsed().as_secs_f64() * 1e9 / (reps * pos.len()) as f64;
-            println!("{}", serde_json::json!({"bench":"voidage","method":name,"voidage":target,"particles":pos.len(),"l1":l1,"ns_per_particle":ns,"threads":threads}));
+            println!(
+                "{}",
+                serde_json::json!({"bench":"voidage","method":name,"voidage":target,"particles":pos.len(),"l1":l1,"ns_per_particle":ns,"threads":threads})
+            );
             rows[k].push((l1, ns));
         }
     }
@@ -89,5 +99,8 @@ pub fn run() {
         .min_by(|x, y| x.1[1].0.partial_cmp(&y.1[1].0).unwrap())
         .map(|(n, r)| (n.clone(), r[1]))
         .unwrap();
-    println!("{}", serde_json::json!({"name":"voidage","most_accurate_at_0.6":best.0,"l1":best.1.0,"ns_per_particle":best.1.1,"threads":threads}));
+    println!(
+        "{}",
+        serde_json::json!({"name":"voidage","most_accurate_at_0.6":best.0,"l1":best.1.0,"ns_per_particle":best.1.1,"threads":threads})
+    );
 }

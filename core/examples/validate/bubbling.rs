@@ -61,11 +61,21 @@ pub fn run_to(end_s: f64) -> RunSummary {
             let [plate, tube, _] = dem.wall_loads();
             budget.push([s.time_s, plate, tube, dem.external_force_total()[2], dem.momentum()[2]]);
             if s.index % 10 == 0 {
-                eprintln!("[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s", s.time_s, s.pressure_drop_pa.unwrap_or(0.0), t0.elapsed().as_secs_f64());
+                eprintln!(
+                    "[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s",
+                    s.time_s,
+                    s.pressure_drop_pa.unwrap_or(0.0),
+                    t0.elapsed().as_secs_f64()
+                );
                 // the ΔP series and budget so far, in case the run is stopped early
-                let dp: Vec<(f64, f64)> = snaps.iter().chain(std::iter::once(&s)).filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p))).collect();
+                let dp: Vec<(f64, f64)> = snaps
+                    .iter()
+                    .chain(std::iter::once(&s))
+                    .filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p)))
+                    .collect();
                 std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-                std::fs::write(format!("{cache}.partial"), json!({"dp": dp, "budget": budget}).to_string()).expect("write partial");
+                std::fs::write(format!("{cache}.partial"), json!({"dp": dp, "budget": budget}).to_string())
+                    .expect("write partial");
             }
             snaps.push(s);
         }
@@ -103,7 +113,10 @@ pub fn run() -> serde_json::Value {
     let want = weight + head;
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= 0.4).map(|x| x.1).collect();
     let mean = tail.iter().sum::<f64>() / tail.len() as f64;
-    eprintln!("ran {:.3} s simulated in {:.0} s wall; largest bubble share of the bed cells {:.3}", r.end_s, r.wall_s, r.bubble_fraction_max);
+    eprintln!(
+        "ran {:.3} s simulated in {:.0} s wall; largest bubble share of the bed cells {:.3}",
+        r.end_s, r.wall_s, r.bubble_fraction_max
+    );
     json!({"name": "bubbling", "figure": r.bubble_fraction_max, "reference": want, "mean_dp_pa": mean, "rel_err": mean / want - 1.0,
            "simulated_s": r.end_s, "wall_s": r.wall_s, "watchdog_stops": 0,
            "note": "figure: largest share of bed cells with ε > 0.8 (bubbles); rel_err: mean ΔP vs bed weight less buoyancy plus the gas head"})

@@ -19,7 +19,9 @@ pub fn load_case_path(path: &str) -> Case {
 
 /// Settled beds are cached here so the validations pour each bed once.
 pub fn bed_cache() -> PathBuf {
-    let dir = std::env::var_os("FLUIDBED_BED_CACHE").map(PathBuf::from).unwrap_or_else(|| PathBuf::from("target/fluidbed-bed-cache"));
+    let dir = std::env::var_os("FLUIDBED_BED_CACHE")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("target/fluidbed-bed-cache"));
     std::fs::create_dir_all(&dir).expect("bed cache dir");
     dir
 }
@@ -28,14 +30,24 @@ pub fn bed_cache() -> PathBuf {
 pub fn run_case(case: Case, label: &str) -> (Simulation, Vec<Snapshot>) {
     let t0 = Instant::now();
     let mut sim = Simulation::new(case, Some(&bed_cache())).unwrap_or_else(|e| panic!("{label}: {e}"));
-    eprintln!("[{label}] {} particles, plan {:?} (built in {:.1} s)", sim.dem().len(), sim.plan(), t0.elapsed().as_secs_f64());
+    eprintln!(
+        "[{label}] {} particles, plan {:?} (built in {:.1} s)",
+        sim.dem().len(),
+        sim.plan(),
+        t0.elapsed().as_secs_f64()
+    );
     let mut snaps = Vec::new();
     let t1 = Instant::now();
     while !sim.is_finished() {
         match sim.advance(u64::MAX) {
             Ok(Some(s)) => {
                 if s.index % 10 == 0 {
-                    eprintln!("[{label}] t = {:.3} s, ΔP = {:?} Pa, wall {:.0} s", s.time_s, s.pressure_drop_pa.map(|x| x.round()), t1.elapsed().as_secs_f64());
+                    eprintln!(
+                        "[{label}] t = {:.3} s, ΔP = {:?} Pa, wall {:.0} s",
+                        s.time_s,
+                        s.pressure_drop_pa.map(|x| x.round()),
+                        t1.elapsed().as_secs_f64()
+                    );
                 }
                 snaps.push(s);
             }

@@ -30,7 +30,10 @@ pub fn run() -> serde_json::Value {
     let methods: [(&str, Voidage); 4] = [
         ("direct", Voidage::Direct),
         ("grouping", Voidage::Grouping),
-        ("square_grid", Voidage::SquareGrid { box_side_m: Some(0.001375), split: BoxSplit::Cuboid, cube_side_factor: 1.0 }),
+        (
+            "square_grid",
+            Voidage::SquareGrid { box_side_m: Some(0.001375), split: BoxSplit::Cuboid, cube_side_factor: 1.0 },
+        ),
         ("exact_cylindrical", Voidage::ExactCylindrical),
     ];
     let mut out = serde_json::Map::new();

@@ -15,7 +15,11 @@ pub fn run(small: bool) -> serde_json::Value {
             // A narrower, shallower bed for `cargo test`: same physics, fewer particles.
             case.column.diameter_m = 0.0264;
             case.column.height_m = 0.0352;
-            case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed { settled_height_m: Some(0.0176), count: None, seed: 1 });
+            case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed {
+                settled_height_m: Some(0.0176),
+                count: None,
+                seed: 1,
+            });
         }
         let g = case.gas.as_mut().unwrap();
         g.superficial_velocity_m_s = u;
@@ -31,7 +35,8 @@ pub fn run(small: bool) -> serde_json::Value {
         let (k1, k2) = (1usize, ((top - d) / dz).floor() as usize - 1);
         assert!(k2 > k1, "bed too shallow for the grid");
         let (grad, eps) = gradient_and_voidage(s, k1, k2);
-        let rho = layers(s, &s.pressure_pa.clone().unwrap())[k1] / sim.case().gas.as_ref().unwrap().sound_speed_m_s().powi(2);
+        let rho =
+            layers(s, &s.pressure_pa.clone().unwrap())[k1] / sim.case().gas.as_ref().unwrap().sound_speed_m_s().powi(2);
         // the gas's own weight adds ρ_g g to the gradient (model A, PHYSICS.md 11)
         let gas_head = rho * sim.case().gravity_m_s2;
         let want = beetstra_gradient(eps, u, d, mu, rho) + gas_head;

@@ -3,7 +3,9 @@
 //! paper's values. Cell mapping: see `fluidbed_core::coupling::voidage::table3`.
 
 use fluidbed_core::case::BoxSplit;
-use fluidbed_core::coupling::voidage::{table3, voidage_from_solid, Direct, ExactCylindrical, Grouping, SquareGrid, VoidageMethod};
+use fluidbed_core::coupling::voidage::{
+    table3, voidage_from_solid, Direct, ExactCylindrical, Grouping, SquareGrid, VoidageMethod,
+};
 use std::f64::consts::PI;
 
 pub fn run() {
@@ -35,8 +37,16 @@ pub fn run() {
         columns.push((name.clone(), cells.iter().map(|&c| eps[c]).collect()));
     }
 
-    println!("Table 3 set-up: {} particles, d = {} mm, grid R = 22 mm, dr = dz = 4.4 mm, n0 = 3;", pos.len(), table3::DIAMETER * 1e3);
-    println!("cell 1 = (i 2, j 1, k 1); V_cell = {:.2} mm³, particle volume {:.2} mm³", g.cell_volume() * 1e9, total * 1e9);
+    println!(
+        "Table 3 set-up: {} particles, d = {} mm, grid R = 22 mm, dr = dz = 4.4 mm, n0 = 3;",
+        pos.len(),
+        table3::DIAMETER * 1e3
+    );
+    println!(
+        "cell 1 = (i 2, j 1, k 1); V_cell = {:.2} mm³, particle volume {:.2} mm³",
+        g.cell_volume() * 1e9,
+        total * 1e9
+    );
     println!("\nThis code (voidage):");
     print!("| cell |");
     for (n, _) in &columns {
@@ -64,12 +74,10 @@ pub fn run() {
     let col = |name: &str| columns.iter().find(|c| c.0 == name).map(|c| c.1.clone()).expect("column");
     let exact = col("exact")[0];
     let figure = col("sg_cuboid_3")[0];
-    let sg_above_below_min = columns
-        .iter()
-        .filter(|c| c.0.starts_with("sg_"))
-        .flat_map(|c| [c.1[7], c.1[8]])
-        .fold(f64::INFINITY, f64::min);
-    let cell1: serde_json::Map<String, serde_json::Value> = columns.iter().map(|(n, v)| (n.clone(), serde_json::json!(v[0]))).collect();
+    let sg_above_below_min =
+        columns.iter().filter(|c| c.0.starts_with("sg_")).flat_map(|c| [c.1[7], c.1[8]]).fold(f64::INFINITY, f64::min);
+    let cell1: serde_json::Map<String, serde_json::Value> =
+        columns.iter().map(|(n, v)| (n.clone(), serde_json::json!(v[0]))).collect();
     let j = serde_json::json!({
         "name": "table3",
         "figure": figure,

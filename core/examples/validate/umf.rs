@@ -29,7 +29,16 @@ struct Sweep {
 
 impl Sweep {
     fn from_env() -> Sweep {
-        let mut s = Sweep { column_mm: 22.0, height_mm: 20.0, seed: 2, start: 0.45, step: 0.025, stages: 11, hold: 0.1, dz_over_dr: 0.5 };
+        let mut s = Sweep {
+            column_mm: 22.0,
+            height_mm: 20.0,
+            seed: 2,
+            start: 0.45,
+            step: 0.025,
+            stages: 11,
+            hold: 0.1,
+            dz_over_dr: 0.5,
+        };
         for kv in std::env::var("FLUIDBED_UMF").unwrap_or_default().split(',').filter(|t| !t.is_empty()) {
             let (k, v) = kv.split_once('=').unwrap_or_else(|| panic!("FLUIDBED_UMF: '{kv}' is not key=value"));
             let x: f64 = v.parse().unwrap_or_else(|_| panic!("FLUIDBED_UMF: '{v}' is not a number"));
@@ -56,7 +65,11 @@ pub fn run() -> serde_json::Value {
         // a narrower column: keep three rings per radius
         case.column.diameter_m = sw.column_mm / 1000.0;
         case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
-        case.voidage = fluidbed_core::case::Voidage::SquareGrid { box_side_m: None, split: fluidbed_core::case::BoxSplit::Cuboid, cube_side_factor: 1.0 };
+        case.voidage = fluidbed_core::case::Voidage::SquareGrid {
+            box_side_m: None,
+            split: fluidbed_core::case::BoxSplit::Cuboid,
+            cube_side_factor: 1.0,
+        };
     }
     let dz = sw.dz_over_dr * case.grid.dr_m;
     case.grid.dz_m = Some(dz);
@@ -65,7 +78,11 @@ pub fn run() -> serde_json::Value {
         // a column three bed heights tall (at least 66 mm), a whole number of layers
         case.column.height_m = ((3.0 * sw.height_mm / 1000.0).max(0.066) / dz).round() * dz;
     }
-    case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed { settled_height_m: Some(sw.height_mm / 1000.0), count: None, seed: sw.seed });
+    case.bed = fluidbed_core::case::Bed::Generated(fluidbed_core::case::GeneratedBed {
+        settled_height_m: Some(sw.height_mm / 1000.0),
+        count: None,
+        seed: sw.seed,
+    });
     let speeds: Vec<f64> = (0..sw.stages).map(|i| sw.start - sw.step * i as f64).collect();
     let (hold, settle) = (sw.hold, sw.hold / 2.0); // per stage: hold time, of which the first half is discarded
     let g = case.gas.as_mut().unwrap();
@@ -95,7 +112,11 @@ pub fn run() -> serde_json::Value {
         if s.time_s >= stage_end - 1e-9 {
             let dp = acc.iter().sum::<f64>() / acc.len().max(1) as f64;
             let eps = core_voidage(&sim);
-            eprintln!("U = {:.3} m/s: ΔP = {dp:.1} Pa ({:.3} of bed weight), bed voidage {eps:.3}", speeds[stage], dp / want_weight);
+            eprintln!(
+                "U = {:.3} m/s: ΔP = {dp:.1} Pa ({:.3} of bed weight), bed voidage {eps:.3}",
+                speeds[stage],
+                dp / want_weight
+            );
             points.push((speeds[stage], dp));
             voidages.push(eps);
             acc.clear();
@@ -133,7 +154,11 @@ fn intersect(points: &[(f64, f64)], weight: f64) -> f64 {
         r2 += u * u * p;
     }
     let det = s11 * s22 - s12 * s12;
-    let (a, b) = if low.len() >= 2 && det.abs() > 0.0 { ((r1 * s22 - r2 * s12) / det, (s11 * r2 - s12 * r1) / det) } else { (r1 / s11.max(1e-300), 0.0) };
+    let (a, b) = if low.len() >= 2 && det.abs() > 0.0 {
+        ((r1 * s22 - r2 * s12) / det, (s11 * r2 - s12 * r1) / det)
+    } else {
+        (r1 / s11.max(1e-300), 0.0)
+    };
     // Solve a U + b U² = plateau for the positive root.
     if b.abs() < 1e-12 {
         plateau / a

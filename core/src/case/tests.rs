@@ -44,7 +44,13 @@ fn every_problem_is_reported_with_its_path() {
         "dem":{"time_step_s":1e-3}}"#;
     let rep = Case::parse_str(bad).unwrap_err();
     let paths: Vec<&str> = rep.errors.iter().map(|p| p.path.as_str()).collect();
-    for want in ["/column/diameter_m", "/particles/poisson_ratio", "/particles/sliding_friction", "/bed/generated", "/dem/time_step_s"] {
+    for want in [
+        "/column/diameter_m",
+        "/particles/poisson_ratio",
+        "/particles/sliding_friction",
+        "/bed/generated",
+        "/dem/time_step_s",
+    ] {
         assert!(paths.contains(&want), "{want} missing from {paths:?}");
     }
     let dt = rep.errors.iter().find(|p| p.path == "/dem/time_step_s").unwrap();

@@ -42,7 +42,14 @@ impl ValidationReport {
     pub fn is_ok(&self) -> bool {
         self.errors.is_empty()
     }
-    fn push(&mut self, severity: Severity, path: &str, value: Value, allowed: impl Into<String>, message: impl Into<String>) {
+    fn push(
+        &mut self,
+        severity: Severity,
+        path: &str,
+        value: Value,
+        allowed: impl Into<String>,
+        message: impl Into<String>,
+    ) {
         let p = Problem { path: path.into(), value, allowed: allowed.into(), message: message.into(), severity };
         match severity {
             Severity::Error => self.errors.push(p),
@@ -60,7 +67,8 @@ impl ValidationReport {
         let ok_lo = if lo_open { x > lo } else { x >= lo };
         let ok_hi = if hi_open { x < hi } else { x <= hi };
         if !(ok_lo && ok_hi) || !x.is_finite() {
-            let allowed = format!("{}{}, {}{}", if lo_open { "(" } else { "[" }, lo, hi, if hi_open { ")" } else { "]" });
+            let allowed =
+                format!("{}{}, {}{}", if lo_open { "(" } else { "[" }, lo, hi, if hi_open { ")" } else { "]" });
             self.error(path, json_num(x), allowed, format!("{what} out of range"));
         }
     }
@@ -134,15 +142,33 @@ impl Case {
         r.range("/column/height_m", c.height_m, 0.0, true, 50.0, false, "column height");
         let p = &self.particles;
         let d = p.diameter_m;
-        r.range("/particles/diameter_m", d, 0.0, true, (c.diameter_m / 4.0).max(0.0), false, "particle diameter (at most a quarter of the column diameter)");
+        r.range(
+            "/particles/diameter_m",
+            d,
+            0.0,
+            true,
+            (c.diameter_m / 4.0).max(0.0),
+            false,
+            "particle diameter (at most a quarter of the column diameter)",
+        );
         r.range("/particles/density_kg_m3", p.density_kg_m3, 0.0, true, 1e5, false, "particle density");
         r.range("/particles/youngs_modulus_pa", p.youngs_modulus_pa, 1e3, false, 1e13, false, "Young's modulus");
         r.range("/particles/poisson_ratio", p.poisson_ratio, 0.0, false, 0.5, true, "Poisson ratio");
         r.range("/particles/sliding_friction", p.sliding_friction, 0.0, false, 10.0, false, "sliding friction");
         for (name, damp) in [("normal_damping", p.normal_damping), ("tangential_damping", p.tangential_damping)] {
             match damp {
-                Damping::TsujiAlpha(a) => r.range(&format!("/particles/{name}/tsuji_alpha"), a, 0.0, false, 2.0, false, "Tsuji damping α"),
-                Damping::Restitution(e) => r.range(&format!("/particles/{name}/restitution"), e, 0.0, true, 1.0, false, "restitution coefficient"),
+                Damping::TsujiAlpha(a) => {
+                    r.range(&format!("/particles/{name}/tsuji_alpha"), a, 0.0, false, 2.0, false, "Tsuji damping α")
+                }
+                Damping::Restitution(e) => r.range(
+                    &format!("/particles/{name}/restitution"),
+                    e,
+                    0.0,
+                    true,
+                    1.0,
+                    false,
+                    "restitution coefficient",
+                ),
             }
         }
         r.range("/gravity_m_s2", self.gravity_m_s2, 0.0, false, 1000.0, false, "gravity");
@@ -150,10 +176,31 @@ impl Case {
         self.validate_bed(&mut r);
         self.validate_dem(&mut r);
         let o = &self.outputs;
-        r.range("/outputs/snapshot_interval_s", o.snapshot_interval_s, self.dem.time_step_s.max(0.0), false, 1e6, false, "snapshot interval (at least one DEM step)");
-        r.range("/outputs/checkpoint_interval_s", o.checkpoint_interval_s, 0.0, false, 1e6, false, "checkpoint interval");
+        r.range(
+            "/outputs/snapshot_interval_s",
+            o.snapshot_interval_s,
+            self.dem.time_step_s.max(0.0),
+            false,
+            1e6,
+            false,
+            "snapshot interval (at least one DEM step)",
+        );
+        r.range(
+            "/outputs/checkpoint_interval_s",
+            o.checkpoint_interval_s,
+            0.0,
+            false,
+            1e6,
+            false,
+            "checkpoint interval",
+        );
         if self.end_time_s / o.snapshot_interval_s.max(1e-300) > 1e6 {
-            r.error("/outputs/snapshot_interval_s", json_num(o.snapshot_interval_s), format!(">= {}", self.end_time_s / 1e6), "more than a million snapshots");
+            r.error(
+                "/outputs/snapshot_interval_s",
+                json_num(o.snapshot_interval_s),
+                format!(">= {}", self.end_time_s / 1e6),
+                "more than a million snapshots",
+            );
         }
         if let Some(g) = &self.gas {
             self.validate_gas(g, &mut r);
@@ -167,7 +214,15 @@ impl Case {
         match &self.bed {
             Bed::Generated(g) => match (g.settled_height_m, g.count) {
                 (Some(hb), None) => {
-                    r.range("/bed/generated/settled_height_m", hb, d, false, h, true, "settled bed height (at least d, below the column top)");
+                    r.range(
+                        "/bed/generated/settled_height_m",
+                        hb,
+                        d,
+                        false,
+                        h,
+                        true,
+                        "settled bed height (at least d, below the column top)",
+                    );
                 }
                 (None, Some(n)) => {
                     if n == 0 || n > 20_000_000 {
@@ -176,10 +231,23 @@ impl Case {
                     // A random packing holds at most ~0.64 solids; the bed must fit in the column.
                     let hb = n as f64 * self.particle_volume_m3() / (0.6 * area);
                     if hb >= h {
-                        r.error("/bed/generated/count", n, format!("a bed below the column top: at most {:.0}", 0.6 * area * h / self.particle_volume_m3()), format!("{n} particles settle to about {hb:.4} m, above the column height {h} m"));
+                        r.error(
+                            "/bed/generated/count",
+                            n,
+                            format!(
+                                "a bed below the column top: at most {:.0}",
+                                0.6 * area * h / self.particle_volume_m3()
+                            ),
+                            format!("{n} particles settle to about {hb:.4} m, above the column height {h} m"),
+                        );
                     }
                 }
-                _ => r.error("/bed/generated", serde_json::to_value(g).unwrap_or(Value::Null), "exactly one of settled_height_m or count", "give a settled height or a particle count, not both or neither"),
+                _ => r.error(
+                    "/bed/generated",
+                    serde_json::to_value(g).unwrap_or(Value::Null),
+                    "exactly one of settled_height_m or count",
+                    "give a settled height or a particle count, not both or neither",
+                ),
             },
             Bed::Explicit(e) => {
                 if e.positions_m.is_empty() {
@@ -187,13 +255,27 @@ impl Case {
                 }
                 for (i, x) in e.positions_m.iter().enumerate() {
                     let rr = (x[0] * x[0] + x[1] * x[1]).sqrt();
-                    if !(rr <= rad - d / 2.0 + 1e-12 && x[2] >= d / 2.0 - 1e-12 && x[2] <= h && x.iter().all(|v| v.is_finite())) {
-                        r.error(&format!("/bed/explicit/positions_m/{i}"), serde_json::to_value(x).unwrap_or(Value::Null), format!("r <= {} m, {} m <= z <= {} m", rad - d / 2.0, d / 2.0, h), "particle outside the column");
+                    if !(rr <= rad - d / 2.0 + 1e-12
+                        && x[2] >= d / 2.0 - 1e-12
+                        && x[2] <= h
+                        && x.iter().all(|v| v.is_finite()))
+                    {
+                        r.error(
+                            &format!("/bed/explicit/positions_m/{i}"),
+                            serde_json::to_value(x).unwrap_or(Value::Null),
+                            format!("r <= {} m, {} m <= z <= {} m", rad - d / 2.0, d / 2.0, h),
+                            "particle outside the column",
+                        );
                     }
                 }
                 if let Some(v) = &e.velocities_m_s {
                     if v.len() != e.positions_m.len() {
-                        r.error("/bed/explicit/velocities_m_s", v.len(), format!("{} entries, one per position", e.positions_m.len()), "velocity count differs from position count");
+                        r.error(
+                            "/bed/explicit/velocities_m_s",
+                            v.len(),
+                            format!("{} entries, one per position", e.positions_m.len()),
+                            "velocity count differs from position count",
+                        );
                     }
                 }
             }
@@ -210,18 +292,44 @@ impl Case {
         let tc = self.hertz_contact_time_s(CHECK_IMPACT_SPEED_M_S);
         if tc.is_finite() && dt > 0.0 {
             if dt > tc / 10.0 {
-                r.error("/dem/time_step_s", json_num(dt), format!("<= t_c/10 = {:.3e} s (t_c = {:.3e} s at 1 m/s)", tc / 10.0, tc), "DEM step too large for the Hertz contact time");
+                r.error(
+                    "/dem/time_step_s",
+                    json_num(dt),
+                    format!("<= t_c/10 = {:.3e} s (t_c = {:.3e} s at 1 m/s)", tc / 10.0, tc),
+                    "DEM step too large for the Hertz contact time",
+                );
             } else if dt > tc / 20.0 {
-                r.warn("/dem/time_step_s", json_num(dt), format!("<= t_c/20 = {:.3e} s recommended", tc / 20.0), "DEM step above t_c/20: contacts resolved by fewer than 20 steps");
+                r.warn(
+                    "/dem/time_step_s",
+                    json_num(dt),
+                    format!("<= t_c/20 = {:.3e} s recommended", tc / 20.0),
+                    "DEM step above t_c/20: contacts resolved by fewer than 20 steps",
+                );
             }
         }
     }
 
     fn validate_gas(&self, g: &Gas, r: &mut ValidationReport) {
-        r.range("/gas/superficial_velocity_m_s", g.superficial_velocity_m_s, 0.0, false, 100.0, false, "superficial velocity");
+        r.range(
+            "/gas/superficial_velocity_m_s",
+            g.superficial_velocity_m_s,
+            0.0,
+            false,
+            100.0,
+            false,
+            "superficial velocity",
+        );
         r.range("/gas/ramp_time_s", g.ramp_time_s, 0.0, false, 1e4, false, "ramp time");
         r.range("/gas/temperature_k", g.temperature_k, 1.0, false, 5000.0, false, "temperature");
-        r.range("/gas/specific_gas_constant_j_kg_k", g.specific_gas_constant_j_kg_k, 1.0, false, 1e5, false, "specific gas constant");
+        r.range(
+            "/gas/specific_gas_constant_j_kg_k",
+            g.specific_gas_constant_j_kg_k,
+            1.0,
+            false,
+            1e5,
+            false,
+            "specific gas constant",
+        );
         r.range("/gas/viscosity_pa_s", g.viscosity_pa_s, 0.0, true, 1.0, false, "viscosity");
         r.range("/gas/bulk_viscosity_pa_s", g.bulk_viscosity_pa_s, 0.0, false, 1.0, false, "bulk viscosity");
         r.range("/gas/outlet_pressure_pa", g.outlet_pressure_pa, 1.0, false, 1e8, false, "outlet pressure");
@@ -237,12 +345,22 @@ impl Case {
             if dt > 0.0 && dem > 0.0 {
                 let n = dt / dem;
                 if n < 1.0 - 1e-9 || (n - n.round()).abs() > 1e-6 * n {
-                    r.error("/gas/time_step_s", json_num(dt), format!("a whole multiple of the DEM step {dem:e} s, e.g. {:e} s", dem * n.round().max(1.0)), "the gas step must be a whole number of DEM steps");
+                    r.error(
+                        "/gas/time_step_s",
+                        json_num(dt),
+                        format!("a whole multiple of the DEM step {dem:e} s, e.g. {:e} s", dem * n.round().max(1.0)),
+                        "the gas step must be a whole number of DEM steps",
+                    );
                 }
             }
             if let Some(limit) = crate::cfd::case_stable_time_step(self) {
                 if dt > limit {
-                    r.error("/gas/time_step_s", json_num(dt), format!("<= {limit:.4e} s (acoustic CFL limit with AB3, cfl_factor {})", g.cfl_factor), format!("gas time step {dt:e} s exceeds the largest stable step {limit:.4e} s"));
+                    r.error(
+                        "/gas/time_step_s",
+                        json_num(dt),
+                        format!("<= {limit:.4e} s (acoustic CFL limit with AB3, cfl_factor {})", g.cfl_factor),
+                        format!("gas time step {dt:e} s exceeds the largest stable step {limit:.4e} s"),
+                    );
                 }
             }
         }
@@ -252,7 +370,15 @@ impl Case {
         if gr.dr_m > 0.0 {
             let n = rad / gr.dr_m;
             if (n - n.round()).abs() > 1e-6 * n.max(1.0) {
-                r.error("/grid/dr_m", json_num(gr.dr_m), format!("the column radius {rad} m divided by a whole number, e.g. {:.6}", rad / n.round().max(1.0)), "dr does not divide the radius into whole annuli");
+                r.error(
+                    "/grid/dr_m",
+                    json_num(gr.dr_m),
+                    format!(
+                        "the column radius {rad} m divided by a whole number, e.g. {:.6}",
+                        rad / n.round().max(1.0)
+                    ),
+                    "dr does not divide the radius into whole annuli",
+                );
             }
         }
         if gr.n0 < 3 || gr.n0 > 64 {
@@ -263,18 +389,36 @@ impl Case {
             r.range("/grid/dz_m", dz, 0.0, true, self.column.height_m, false, "axial spacing");
             let n = self.column.height_m / dz;
             if dz > 0.0 && (n - n.round()).abs() > 1e-6 * n.max(1.0) {
-                r.error("/grid/dz_m", json_num(dz), format!("the column height divided by a whole number, e.g. {:.6}", self.column.height_m / n.round().max(1.0)), "dz does not divide the column into whole layers");
+                r.error(
+                    "/grid/dz_m",
+                    json_num(dz),
+                    format!(
+                        "the column height divided by a whole number, e.g. {:.6}",
+                        self.column.height_m / n.round().max(1.0)
+                    ),
+                    "dz does not divide the column into whole layers",
+                );
             }
         }
         let d = self.particles.diameter_m;
         if gr.dr_m > 0.0 && (d >= gr.dr_m || d >= dz) {
-            r.error("/particles/diameter_m", json_num(d), format!("< min(dr, dz) = {} m", gr.dr_m.min(dz)), "particle larger than a fluid cell: volume averaging needs cells larger than the particles");
+            r.error(
+                "/particles/diameter_m",
+                json_num(d),
+                format!("< min(dr, dz) = {} m", gr.dr_m.min(dz)),
+                "particle larger than a fluid cell: volume averaging needs cells larger than the particles",
+            );
         }
         if let Voidage::SquareGrid { box_side_m, cube_side_factor, .. } = &self.voidage {
             if let Some(b) = box_side_m {
                 r.range("/voidage/box_side_m", *b, 0.0, true, self.column.diameter_m, false, "box side");
                 if *b < d {
-                    r.warn("/voidage/box_side_m", json_num(*b), format!(">= d = {d} m"), "boxes smaller than a particle: the split is less smooth");
+                    r.warn(
+                        "/voidage/box_side_m",
+                        json_num(*b),
+                        format!(">= d = {d} m"),
+                        "boxes smaller than a particle: the split is less smooth",
+                    );
                 }
             }
             r.range("/voidage/cube_side_factor", *cube_side_factor, 0.1, false, 2.0, false, "cuboid side / d");

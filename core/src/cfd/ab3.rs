@@ -25,7 +25,11 @@ pub fn combine(y: &mut [f64], y0: &[f64], f: &[&[f64]], w: &[f64]) {
     match *f {
         [a] => y.iter_mut().zip(y0).zip(a).for_each(|((y, y0), a)| *y = y0 + w[0] * a),
         [a, b] => y.iter_mut().zip(y0).zip(a.iter().zip(b)).for_each(|((y, y0), (a, b))| *y = y0 + w[0] * a + w[1] * b),
-        [a, b, c] => y.iter_mut().zip(y0).zip(a.iter().zip(b.iter().zip(c))).for_each(|((y, y0), (a, (b, c)))| *y = y0 + w[0] * a + w[1] * b + w[2] * c),
+        [a, b, c] => y
+            .iter_mut()
+            .zip(y0)
+            .zip(a.iter().zip(b.iter().zip(c)))
+            .for_each(|((y, y0), (a, (b, c)))| *y = y0 + w[0] * a + w[1] * b + w[2] * c),
         _ => unreachable!("one to three right-hand sides"),
     }
 }
@@ -61,7 +65,10 @@ mod tests {
                 _ => {
                     let b = ab3_weights(h, hs[0], hs[1]);
                     let (f1, f2) = (hist[0], hist[1]);
-                    (y.0 + h * (b[0] * f0.0 + b[1] * f1.0 + b[2] * f2.0), y.1 + h * (b[0] * f0.1 + b[1] * f1.1 + b[2] * f2.1))
+                    (
+                        y.0 + h * (b[0] * f0.0 + b[1] * f1.0 + b[2] * f2.0),
+                        y.1 + h * (b[0] * f0.1 + b[1] * f1.1 + b[2] * f2.1),
+                    )
                 }
             };
             hist.insert(0, f0);
@@ -75,7 +82,11 @@ mod tests {
     #[test]
     fn weights_reduce_to_the_constant_step_values() {
         let b = ab3_weights(0.1, 0.1, 0.1);
-        assert!((b[0] - 23.0 / 12.0).abs() < 1e-14 && (b[1] + 16.0 / 12.0).abs() < 1e-14 && (b[2] - 5.0 / 12.0).abs() < 1e-14);
+        assert!(
+            (b[0] - 23.0 / 12.0).abs() < 1e-14
+                && (b[1] + 16.0 / 12.0).abs() < 1e-14
+                && (b[2] - 5.0 / 12.0).abs() < 1e-14
+        );
         let b = ab2_weights(0.1, 0.1);
         assert!((b[0] - 1.5).abs() < 1e-15 && (b[1] + 0.5).abs() < 1e-15);
     }

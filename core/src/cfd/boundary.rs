@@ -16,7 +16,16 @@ pub fn ramped_superficial_velocity(u_set: f64, ramp_time: f64, t: f64) -> f64 {
 /// eq. 5–6 with the printed typo "2U²a⁴" mended to "3U²a⁴" reduce to the σ = 0 form).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn outlet_density_change(d_rho_uz: f64, uz: f64, a: f64, rho: f64, rho_inf: f64, sigma: f64, length: f64, dt: f64) -> f64 {
+pub fn outlet_density_change(
+    d_rho_uz: f64,
+    uz: f64,
+    a: f64,
+    rho: f64,
+    rho_inf: f64,
+    sigma: f64,
+    length: f64,
+    dt: f64,
+) -> f64 {
     let mach2 = (uz / a).powi(2);
     let k = sigma * (1.0 - mach2).max(0.0) * a / length;
     (d_rho_uz - dt * k * a * (rho - rho_inf)) / (uz + a)
@@ -29,8 +38,10 @@ mod tests {
     /// The paper's printed ratio σ₁σ₂/σ₃ of eq. (6), with s5's U²a⁴ coefficient given as `c`
     /// (printed 2; PHYSICS.md 9 shows it must be 3).
     fn paper_eq6_ratio(u: f64, a: f64, c: f64) -> f64 {
-        let s1 = u.powi(5) + u.powi(4) * a - 2.0 * u.powi(3) * a * a - 2.0 * u * u * a.powi(3) + u * a.powi(4) + a.powi(5);
-        let s2 = u.powi(5) - u.powi(4) * a - 2.0 * u.powi(3) * a * a + 2.0 * u * u * a.powi(3) + u * a.powi(4) - a.powi(5);
+        let s1 =
+            u.powi(5) + u.powi(4) * a - 2.0 * u.powi(3) * a * a - 2.0 * u * u * a.powi(3) + u * a.powi(4) + a.powi(5);
+        let s2 =
+            u.powi(5) - u.powi(4) * a - 2.0 * u.powi(3) * a * a + 2.0 * u * u * a.powi(3) + u * a.powi(4) - a.powi(5);
         let s5 = u.powi(6) - 3.0 * u.powi(4) * a * a + c * u * u * a.powi(4) - a.powi(6);
         let s6 = 2.0 * u.powi(4) * a - 4.0 * u * u * a.powi(3) + 2.0 * a.powi(5);
         let s3 = s2 * s5 + s6 * s5;

@@ -68,7 +68,8 @@ impl FaceGeometry {
                 centre[c] = (r * th.cos(), r * th.sin());
             }
         }
-        let dist = |a: usize, b: usize| ((centre[a].0 - centre[b].0).powi(2) + (centre[a].1 - centre[b].1).powi(2)).sqrt();
+        let dist =
+            |a: usize, b: usize| ((centre[a].0 - centre[b].0).powi(2) + (centre[a].1 - centre[b].1).powi(2)).sqrt();
         let mut faces = Vec::new();
         for i in 0..g.nr {
             let n = g.cells_in_annulus(i);
@@ -80,7 +81,16 @@ impl FaceGeometry {
                 let b = g.layer_index(i, (j + 1) % n);
                 let area = dr * dz;
                 let (dx, dy) = (centre[b].0 - centre[a].0, centre[b].1 - centre[a].1);
-                faces.push(HFace { a: a as u32, b: b as u32, sx: -th.sin() * area, sy: th.cos() * area, area_over_delta: area / dist(a, b), s_abs: area, dx, dy });
+                faces.push(HFace {
+                    a: a as u32,
+                    b: b as u32,
+                    sx: -th.sin() * area,
+                    sy: th.cos() * area,
+                    area_over_delta: area / dist(a, b),
+                    s_abs: area,
+                    dx,
+                    dy,
+                });
                 // Radial segments shared with the outer annulus.
                 if i + 1 < g.nr {
                     let r = (i + 1) as f64 * dr;
@@ -93,7 +103,16 @@ impl FaceGeometry {
                         let (sx, sy) = (r * dz * (t1.sin() - t0.sin()), r * dz * (t0.cos() - t1.cos()));
                         let arc = r * dz * (t1 - t0);
                         let (dx, dy) = (centre[b].0 - centre[a].0, centre[b].1 - centre[a].1);
-                        faces.push(HFace { a: a as u32, b: b as u32, sx, sy, area_over_delta: arc / dist(a, b), s_abs: sx.hypot(sy), dx, dy });
+                        faces.push(HFace {
+                            a: a as u32,
+                            b: b as u32,
+                            sx,
+                            sy,
+                            area_over_delta: arc / dist(a, b),
+                            s_abs: sx.hypot(sy),
+                            dx,
+                            dy,
+                        });
                     }
                 }
             }
@@ -184,7 +203,12 @@ mod tests {
         for i in 0..g.nr - 1 {
             for j in 0..g.cells_in_annulus(i) {
                 let c = g.layer_index(i, j) as u32;
-                let chord: f64 = geo.faces.iter().filter(|f| f.a == c && g.ijk(f.b as usize).0 == i + 1).map(|f| f.sx.hypot(f.sy)).sum();
+                let chord: f64 = geo
+                    .faces
+                    .iter()
+                    .filter(|f| f.a == c && g.ijk(f.b as usize).0 == i + 1)
+                    .map(|f| f.sx.hypot(f.sy))
+                    .sum();
                 let r = (i + 1) as f64 * g.dr;
                 let whole = 2.0 * r * g.dz * (g.dtheta(i) / 2.0).sin();
                 // Chords of the parts are at least the chord of the whole, at most the arc.

@@ -47,7 +47,17 @@ pub struct Primitives {
 impl Primitives {
     pub fn new(n: usize) -> Primitives {
         let z = vec![0.0; n];
-        Primitives { ux: z.clone(), uy: z.clone(), uz: z.clone(), p: z.clone(), div: z.clone(), gx: z.clone(), gy: z.clone(), gz: z.clone(), beta: z }
+        Primitives {
+            ux: z.clone(),
+            uy: z.clone(),
+            uz: z.clone(),
+            p: z.clone(),
+            div: z.clone(),
+            gx: z.clone(),
+            gy: z.clone(),
+            gz: z.clone(),
+            beta: z,
+        }
     }
 }
 
@@ -84,7 +94,16 @@ impl RhsInput<'_> {
 
 /// Fill the primitive fields of one layer from the state.
 #[allow(clippy::too_many_arguments)]
-pub fn primitives_layer(inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64], beta: &mut [f64]) {
+pub fn primitives_layer(
+    inp: &RhsInput,
+    q: &[[f64; 4]],
+    k: usize,
+    ux: &mut [f64],
+    uy: &mut [f64],
+    uz: &mut [f64],
+    p: &mut [f64],
+    beta: &mut [f64],
+) {
     let a2 = inp.params.sound_speed * inp.params.sound_speed;
     let base = k * inp.per;
     for c in 0..inp.per {
@@ -139,7 +158,15 @@ pub fn top_face_pressure(outlet: Outlet, p_top: f64, p_below: f64, gravity: f64,
 /// takes the cell's own values (u·n = 0, p_f = p_c); the ends as in the functions above (the inlet
 /// face velocity U/ε_in, a shut top 0, the outlet zero-gradient).
 #[allow(clippy::too_many_arguments)]
-pub fn gradients_layer(inp: &RhsInput, pr: &Primitives, k: usize, div: &mut [f64], gx: &mut [f64], gy: &mut [f64], gz: &mut [f64]) {
+pub fn gradients_layer(
+    inp: &RhsInput,
+    pr: &Primitives,
+    k: usize,
+    div: &mut [f64],
+    gx: &mut [f64],
+    gy: &mut [f64],
+    gz: &mut [f64],
+) {
     let (per, base, geo, par) = (inp.per, k * inp.per, inp.geo, inp.params);
     let a2 = par.sound_speed * par.sound_speed;
     for c in 0..per {
@@ -164,7 +191,11 @@ pub fn gradients_layer(inp: &RhsInput, pr: &Primitives, k: usize, div: &mut [f64
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
     for c in 0..per {
         let i = base + c;
-        let (w_bot, p_bot) = if k == 0 { (w_in, inlet_face_pressure(pr.p[i], (inp.nz > 1).then(|| pr.p[i + per]), par.gravity, inp.dz, a2)) } else { (0.5 * (pr.uz[i - per] + pr.uz[i]), 0.5 * (pr.p[i - per] + pr.p[i])) };
+        let (w_bot, p_bot) = if k == 0 {
+            (w_in, inlet_face_pressure(pr.p[i], (inp.nz > 1).then(|| pr.p[i + per]), par.gravity, inp.dz, a2))
+        } else {
+            (0.5 * (pr.uz[i - per] + pr.uz[i]), 0.5 * (pr.p[i - per] + pr.p[i]))
+        };
         let (w_top, p_top) = if k + 1 < inp.nz {
             (0.5 * (pr.uz[i] + pr.uz[i + per]), 0.5 * (pr.p[i] + pr.p[i + per]))
         } else {
@@ -211,9 +242,17 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: us
     let mflux = (0.5 * (q[lo][3] + q[hi][3]) + ff) * az - diss;
     let a = par.sound_speed;
     let rho_f = 0.5 * (pr.p[lo] + pr.p[hi]) / (a * a);
-    let dff = if corrected { face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[lo] + pr.beta[hi]), mismatch, inp.dz, ff, a) } else { 0.0 };
+    let dff = if corrected {
+        face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[lo] + pr.beta[hi]), mismatch, inp.dz, ff, a)
+    } else {
+        0.0
+    };
     // Upwind cell C, its upwind U (None at the ends: first-order upwind) and downwind D.
-    let (c, u, d) = if mflux >= 0.0 { (lo, if kl >= 1 { Some(lo - per) } else { None }, hi) } else { (hi, if kl + 2 < inp.nz { Some(hi + per) } else { None }, lo) };
+    let (c, u, d) = if mflux >= 0.0 {
+        (lo, if kl >= 1 { Some(lo - per) } else { None }, hi)
+    } else {
+        (hi, if kl + 2 < inp.nz { Some(hi + per) } else { None }, lo)
+    };
     let face = |v: &[f64]| match u {
         Some(u) => smart_face(v[u], v[c], v[d]),
         None => v[c],
@@ -228,7 +267,15 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: us
 /// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
 /// layer's face corrections: the axial faces above its cells into `out_fz` (one layer long, zero
 /// for the top layer), its horizontal faces into `out_fh`.
-pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize, out: &mut [[f64; 4]], out_fz: &mut [f64], out_fh: &mut [f64]) {
+pub fn residual_layer(
+    inp: &RhsInput,
+    q: &[[f64; 4]],
+    pr: &Primitives,
+    k: usize,
+    out: &mut [[f64; 4]],
+    out_fz: &mut [f64],
+    out_fh: &mut [f64],
+) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let base = k * per;
     out_fz.iter_mut().for_each(|r| *r = 0.0);
@@ -260,12 +307,21 @@ pub fn residual_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, k: usize,
         let diss = kappa_a * eps_f * f.s_abs * mismatch;
         let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) + ff_h[n] * f.s_abs - diss;
         let rho_f = 0.5 * (pr.p[a] + pr.p[b]) / a2;
-        out_fh[n] = face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[a] + pr.beta[b]), mismatch, f.dx.hypot(f.dy), ff_h[n], par.sound_speed);
+        out_fh[n] = face_flux_rate(
+            eps_f,
+            rho_f,
+            0.5 * (pr.beta[a] + pr.beta[b]),
+            mismatch,
+            f.dx.hypot(f.dy),
+            ff_h[n],
+            par.sound_speed,
+        );
         let h = 0.5 * mflux * inv_v;
         let conv = [mflux * inv_v, h * (pr.ux[a] + pr.ux[b]), h * (pr.uy[a] + pr.uy[b]), h * (pr.uz[a] + pr.uz[b])];
         let m = par.viscosity * f.area_over_delta * inv_v;
         let lam = lam_coef * 0.5 * (pr.div[a] + pr.div[b]) * inv_v;
-        let v = [m * (pr.ux[b] - pr.ux[a]) + lam * f.sx, m * (pr.uy[b] - pr.uy[a]) + lam * f.sy, m * (pr.uz[b] - pr.uz[a])];
+        let v =
+            [m * (pr.ux[b] - pr.ux[a]) + lam * f.sx, m * (pr.uy[b] - pr.uy[a]) + lam * f.sy, m * (pr.uz[b] - pr.uz[a])];
         let (ea, eb) = (inp.eps[a], inp.eps[b]);
         let ra = &mut out[la];
         ra[0] -= conv[0];

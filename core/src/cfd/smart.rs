@@ -42,7 +42,11 @@ mod tests {
         let rhs = |q: &Vec<f64>| -> Vec<f64> {
             let face = |i: usize| {
                 let (u, c, d) = (q[(i + n - 1) % n], q[i], q[(i + 1) % n]);
-                if limited { smart_face(u, c, d) } else { (6.0 * c + 3.0 * d - u) / 8.0 }
+                if limited {
+                    smart_face(u, c, d)
+                } else {
+                    (6.0 * c + 3.0 * d - u) / 8.0
+                }
             };
             (0..n).map(|i| -(face(i) - face((i + n - 1) % n)) / dx).collect()
         };

@@ -4,7 +4,9 @@
 use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::outlet_density_change;
 use super::geometry::FaceGeometry;
-use super::rhs::{gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives, RhsInput};
+use super::rhs::{
+    gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives, RhsInput,
+};
 use super::stability::cell_stable_dt;
 use crate::case::Case;
 use crate::grid::CylGrid;
@@ -108,7 +110,21 @@ impl GasSolver {
         };
         let n = grid.num_cells();
         let spec = GridSpec { radius: grid.radius, height: grid.height, dr: grid.dr, dz: grid.dz, n0: grid.n0 };
-        let st = State { grid: spec, params, time: 0.0, steps: 0, q: vec![[0.0; 4]; n], eps: vec![1.0; n], force: vec![[0.0; 3]; n], hist: [vec![[0.0; 4]; n], vec![[0.0; 4]; n], vec![[0.0; 4]; n]], hist_h: [0.0; 2], hist_len: 0, head: 0, face_flux: Vec::new(), hist_face: Default::default() };
+        let st = State {
+            grid: spec,
+            params,
+            time: 0.0,
+            steps: 0,
+            q: vec![[0.0; 4]; n],
+            eps: vec![1.0; n],
+            force: vec![[0.0; 3]; n],
+            hist: [vec![[0.0; 4]; n], vec![[0.0; 4]; n], vec![[0.0; 4]; n]],
+            hist_h: [0.0; 2],
+            hist_len: 0,
+            head: 0,
+            face_flux: Vec::new(),
+            hist_face: Default::default(),
+        };
         let mut s = GasSolver::from_state(st, grid);
         for c in 0..n {
             let rho = s.hydrostatic_density(c);
@@ -125,7 +141,17 @@ impl GasSolver {
             st.face_flux = vec![0.0; nf];
             st.hist_face = [vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]];
         }
-        GasSolver { st, geo, prim: Primitives::new(n), q_old: vec![[0.0; 4]; n], stage: vec![[0.0; 4]; n], face_old: vec![0.0; nf], face_stage: vec![0.0; nf], parallel: n >= PARALLEL_MIN_CELLS, grid }
+        GasSolver {
+            st,
+            geo,
+            prim: Primitives::new(n),
+            q_old: vec![[0.0; 4]; n],
+            stage: vec![[0.0; 4]; n],
+            face_old: vec![0.0; nf],
+            face_stage: vec![0.0; nf],
+            parallel: n >= PARALLEL_MIN_CELLS,
+            grid,
+        }
     }
 
     /// ρ(z) = (p_out/a²)·exp(g(H − z)/a²) at the centre of cell c (PHYSICS.md 8).
@@ -250,7 +276,11 @@ impl GasSolver {
         }
         let (nz, par) = (self.grid.nz, &self.st.params);
         let a2 = par.sound_speed * par.sound_speed;
-        let p_bot = if k == 0 { inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, self.grid.dz, a2) } else { 0.5 * (pc + self.pressure_at(cell - per)) };
+        let p_bot = if k == 0 {
+            inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, self.grid.dz, a2)
+        } else {
+            0.5 * (pc + self.pressure_at(cell - per))
+        };
         let p_top = if k + 1 < nz {
             0.5 * (pc + self.pressure_at(cell + per))
         } else {
@@ -273,7 +303,17 @@ impl GasSolver {
             let inv = 1.0 / s[0];
             let uh = (s[1] * s[1] + s[2] * s[2]).sqrt() * inv;
             let nu = nu_num * self.st.eps[c] * inv;
-            dt = dt.min(cell_stable_dt(uh, (s[3] * inv).abs(), p.sound_speed, nu, g.dr, g.dz, g.n0, self.geo.max_laplacian_factor, p.cfl_factor));
+            dt = dt.min(cell_stable_dt(
+                uh,
+                (s[3] * inv).abs(),
+                p.sound_speed,
+                nu,
+                g.dr,
+                g.dz,
+                g.n0,
+                self.geo.max_laplacian_factor,
+                p.cfl_factor,
+            ));
         }
         dt
     }
@@ -285,11 +325,17 @@ impl GasSolver {
             let (i, j, k) = self.grid.ijk(c);
             for (n, v) in s.iter().enumerate() {
                 if !v.is_finite() {
-                    return Err(format!("gas {} = {v} in cell (i={i}, j={j}, k={k}) at t = {:.6e} s", NAMES[n], self.st.time));
+                    return Err(format!(
+                        "gas {} = {v} in cell (i={i}, j={j}, k={k}) at t = {:.6e} s",
+                        NAMES[n], self.st.time
+                    ));
                 }
             }
             if s[0] <= 0.0 {
-                return Err(format!("gas density ρε = {} ≤ 0 in cell (i={i}, j={j}, k={k}) at t = {:.6e} s", s[0], self.st.time));
+                return Err(format!(
+                    "gas density ρε = {} ≤ 0 in cell (i={i}, j={j}, k={k}) at t = {:.6e} s",
+                    s[0], self.st.time
+                ));
             }
             let e = self.st.eps[c];
             if !(e > 0.0 && e.is_finite()) {
@@ -328,7 +374,12 @@ impl GasSolver {
                 }
                 _ => {
                     let b = ab3_weights(dt, h1, h2).map(|w| w * dt);
-                    combine(q, q0, &[f_new.as_flattened(), self.st.hist[i1].as_flattened(), self.st.hist[i2].as_flattened()], &b);
+                    combine(
+                        q,
+                        q0,
+                        &[f_new.as_flattened(), self.st.hist[i1].as_flattened(), self.st.hist[i2].as_flattened()],
+                        &b,
+                    );
                     combine(ff, ff0, &[&g_new, &self.st.hist_face[i1], &self.st.hist_face[i2]], &b);
                 }
             }
@@ -338,7 +389,12 @@ impl GasSolver {
             // Heun corrector: y1 = y0 + h/2 (f(y0) + f(y*)).
             let (mut stage, mut face_stage) = (std::mem::take(&mut self.stage), std::mem::take(&mut self.face_stage));
             self.rhs_into(t + dt, &mut stage, &mut face_stage);
-            combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &[f_new.as_flattened(), stage.as_flattened()], &[0.5 * dt, 0.5 * dt]);
+            combine(
+                self.st.q.as_flattened_mut(),
+                self.q_old.as_flattened(),
+                &[f_new.as_flattened(), stage.as_flattened()],
+                &[0.5 * dt, 0.5 * dt],
+            );
             combine(&mut self.st.face_flux, &self.face_old, &[&g_new, &face_stage], &[0.5 * dt, 0.5 * dt]);
             (self.stage, self.face_stage) = (stage, face_stage);
             self.apply_outlet(dt);
@@ -373,7 +429,16 @@ impl GasSolver {
                 new[n] = old[n] + et * (self.st.q[below][n] - self.q_old[below][n]) / eb;
             }
             let d_rho_uz = (new[3] - old[3]) / et;
-            let d_rho = outlet_density_change(d_rho_uz, old[3] / old[0], a, old[0] / et, rho_inf, p.outlet_relaxation, self.grid.height, dt);
+            let d_rho = outlet_density_change(
+                d_rho_uz,
+                old[3] / old[0],
+                a,
+                old[0] / et,
+                rho_inf,
+                p.outlet_relaxation,
+                self.grid.height,
+                dt,
+            );
             new[0] = old[0] + et * d_rho;
             self.st.q[top] = new;
         }
@@ -384,28 +449,74 @@ impl GasSolver {
     fn rhs_into(&mut self, t: f64, out: &mut [[f64; 4]], out_face: &mut [f64]) {
         let per = self.grid.cells_per_layer();
         let nf = self.geo.faces.len().max(1);
-        let inp = RhsInput { geo: &self.geo, params: &self.st.params, per, nz: self.grid.nz, dz: self.grid.dz, eps: &self.st.eps, force: &self.st.force, face_flux: &self.st.face_flux, time: t };
+        let inp = RhsInput {
+            geo: &self.geo,
+            params: &self.st.params,
+            per,
+            nz: self.grid.nz,
+            dz: self.grid.dz,
+            eps: &self.st.eps,
+            force: &self.st.force,
+            face_flux: &self.st.face_flux,
+            time: t,
+        };
         let q = &self.st.q;
         let pr = &mut self.prim;
         let (out_fz, out_fh) = out_face.split_at_mut(q.len());
         if self.parallel {
             let beta = &mut pr.beta;
-            pr.ux.par_chunks_mut(per).zip(pr.uy.par_chunks_mut(per)).zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per))).zip(beta.par_chunks_mut(per)).enumerate().for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
-            let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
+            pr.ux
+                .par_chunks_mut(per)
+                .zip(pr.uy.par_chunks_mut(per))
+                .zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per)))
+                .zip(beta.par_chunks_mut(per))
+                .enumerate()
+                .for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
+            let (mut div, mut gx, mut gy, mut gz) = (
+                std::mem::take(&mut pr.div),
+                std::mem::take(&mut pr.gx),
+                std::mem::take(&mut pr.gy),
+                std::mem::take(&mut pr.gz),
+            );
             let prr = &*pr;
-            div.par_chunks_mut(per).zip(gx.par_chunks_mut(per)).zip(gy.par_chunks_mut(per).zip(gz.par_chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
+            div.par_chunks_mut(per)
+                .zip(gx.par_chunks_mut(per))
+                .zip(gy.par_chunks_mut(per).zip(gz.par_chunks_mut(per)))
+                .enumerate()
+                .for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
             (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
             let pr = &*pr;
-            out.par_chunks_mut(per).zip(out_fz.par_chunks_mut(per).zip(out_fh.par_chunks_mut(nf))).enumerate().for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
+            out.par_chunks_mut(per)
+                .zip(out_fz.par_chunks_mut(per).zip(out_fh.par_chunks_mut(nf)))
+                .enumerate()
+                .for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
         } else {
             let beta = &mut pr.beta;
-            pr.ux.chunks_mut(per).zip(pr.uy.chunks_mut(per)).zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per))).zip(beta.chunks_mut(per)).enumerate().for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
-            let (mut div, mut gx, mut gy, mut gz) = (std::mem::take(&mut pr.div), std::mem::take(&mut pr.gx), std::mem::take(&mut pr.gy), std::mem::take(&mut pr.gz));
+            pr.ux
+                .chunks_mut(per)
+                .zip(pr.uy.chunks_mut(per))
+                .zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per)))
+                .zip(beta.chunks_mut(per))
+                .enumerate()
+                .for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
+            let (mut div, mut gx, mut gy, mut gz) = (
+                std::mem::take(&mut pr.div),
+                std::mem::take(&mut pr.gx),
+                std::mem::take(&mut pr.gy),
+                std::mem::take(&mut pr.gz),
+            );
             let prr = &*pr;
-            div.chunks_mut(per).zip(gx.chunks_mut(per)).zip(gy.chunks_mut(per).zip(gz.chunks_mut(per))).enumerate().for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
+            div.chunks_mut(per)
+                .zip(gx.chunks_mut(per))
+                .zip(gy.chunks_mut(per).zip(gz.chunks_mut(per)))
+                .enumerate()
+                .for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
             (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
             let pr = &*pr;
-            out.chunks_mut(per).zip(out_fz.chunks_mut(per).zip(out_fh.chunks_mut(nf))).enumerate().for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
+            out.chunks_mut(per)
+                .zip(out_fz.chunks_mut(per).zip(out_fh.chunks_mut(nf)))
+                .enumerate()
+                .for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
         }
     }
 }

@@ -18,7 +18,17 @@ use crate::grid::CylGrid;
 /// Stable step of one cell state (see the module comment).
 #[allow(clippy::too_many_arguments)]
 #[inline]
-pub fn cell_stable_dt(u_h: f64, u_z: f64, a: f64, nu: f64, dr: f64, dz: f64, n0: usize, laplacian_factor: f64, cfl: f64) -> f64 {
+pub fn cell_stable_dt(
+    u_h: f64,
+    u_z: f64,
+    a: f64,
+    nu: f64,
+    dr: f64,
+    dz: f64,
+    n0: usize,
+    laplacian_factor: f64,
+    cfl: f64,
+) -> f64 {
     let a = a / (1.0 - FACE_FLUX_RATE).sqrt();
     let lam_c = (u_h + a) * horizontal_inverse_spacing(dr, n0) + (u_z + a) / dz;
     let lam_v = 2.0 * nu * laplacian_factor;

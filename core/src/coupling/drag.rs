@@ -41,11 +41,7 @@ mod tests {
 
     #[test]
     fn reproduces_the_physics_reference_table() {
-        let table = [
-            (0.4, [37.846, 41.195, 89.789]),
-            (0.6, [11.813, 13.464, 30.742]),
-            (0.8, [4.194, 5.187, 12.948]),
-        ];
+        let table = [(0.4, [37.846, 41.195, 89.789]), (0.6, [11.813, 13.464, 30.742]), (0.8, [4.194, 5.187, 12.948])];
         for (eps, row) in table {
             for (re, want) in [0.0, 10.0, 100.0].iter().zip(row) {
                 let got = beetstra_f(eps, *re);

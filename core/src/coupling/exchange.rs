@@ -113,7 +113,13 @@ impl Exchange {
                 cell_basis.push((th.cos(), th.sin()));
             }
         }
-        Exchange { cell_basis, cell_of: vec![0; particles], drag_cyl: vec![[0.0; 3]; particles], frozen: Vec::new(), cell_drag: Vec::new() }
+        Exchange {
+            cell_basis,
+            cell_of: vec![0; particles],
+            drag_cyl: vec![[0.0; 3]; particles],
+            frozen: Vec::new(),
+            cell_drag: Vec::new(),
+        }
     }
 
     /// Fluid force on every particle (Cartesian, −V_p∇p + drag) into `force_out`, and the
@@ -147,8 +153,10 @@ impl Exchange {
         // 1. per particle (parallel): its cell, the drag, and the total force −V_p∇p + drag, with
         //    the gas vectors turned to Cartesian at the particle's own angle (paper section 2.3);
         //    the drag also in the basis of its cell's centre, for the gas
-        (force_out, &mut self.drag_cyl[..], &mut self.cell_of[..]).into_par_iter().zip(pos.par_iter().zip(vel.par_iter())).for_each(
-            |((f, dc, co), (p, v))| {
+        (force_out, &mut self.drag_cyl[..], &mut self.cell_of[..])
+            .into_par_iter()
+            .zip(pos.par_iter().zip(vel.par_iter()))
+            .for_each(|((f, dc, co), (p, v))| {
                 // The cell of the last call is a hint (particles move little; after a re-sort
                 // the hint is another particle's and `locate_near` falls back to `locate`).
                 let c = grid.locate_near(p[0], p[1], p[2], *co as usize);
@@ -162,8 +170,7 @@ impl Exchange {
                 let (cc, sc) = basis[lc];
                 *dc = cart_to_cyl(dr, cc, sc);
                 *co = c as u32;
-            },
-        );
+            });
         // 2. the gas loses the drag in the cell of the particle's centre (serial, fixed order:
         //    deterministic)
         cell_force_out.iter_mut().for_each(|f| *f = [0.0; 3]);
@@ -195,7 +202,15 @@ impl Exchange {
     /// cell's velocity; summed, I_c = −D(|u_c|)·(C u_r − S u_θ, S u_r + C u_θ, N u_z)/V_cell with
     /// N, C = Σcos, S = Σsin over the cell's particles. Equal to `Exchange::particle_gas_forces`' gas side
     /// to round-off; the particles' own forces are not needed (they do not move).
-    pub fn frozen_cell_forces(&self, grid: &CylGrid, gas: &GasAtCells, mu: f64, eps_min: f64, d: f64, cell_force_out: &mut [[f64; 3]]) {
+    pub fn frozen_cell_forces(
+        &self,
+        grid: &CylGrid,
+        gas: &GasAtCells,
+        mu: f64,
+        eps_min: f64,
+        d: f64,
+        cell_force_out: &mut [[f64; 3]],
+    ) {
         assert_eq!(self.frozen.len(), grid.num_cells(), "freeze() first");
         let inv_v = 1.0 / grid.cell_volume();
         for (c, (f, &(n, cs, sn))) in cell_force_out.iter_mut().zip(&self.frozen).enumerate() {
@@ -207,8 +222,16 @@ impl Exchange {
             // drag_force is linear in the slip at fixed |slip|: its coefficient from a unit call
             let k = drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, u);
             let w = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-            let coef = if w > 0.0 { (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt() / w } else { drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, [0.0, 0.0, 1.0])[2] };
-            *f = [-coef * (cs * u[0] - sn * u[1]) * inv_v, -coef * (sn * u[0] + cs * u[1]) * inv_v, -coef * n * u[2] * inv_v];
+            let coef = if w > 0.0 {
+                (k[0] * k[0] + k[1] * k[1] + k[2] * k[2]).sqrt() / w
+            } else {
+                drag_force(mu, gas.density[c], d, gas.voidage[c], eps_min, [0.0, 0.0, 1.0])[2]
+            };
+            *f = [
+                -coef * (cs * u[0] - sn * u[1]) * inv_v,
+                -coef * (sn * u[0] + cs * u[1]) * inv_v,
+                -coef * n * u[2] * inv_v,
+            ];
         }
     }
 }
@@ -272,9 +295,11 @@ mod tests {
         let g = grid();
         let n = g.num_cells();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        let vel_c: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
+        let vel_c: Vec<[f64; 3]> =
+            (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
         let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
-        let grad: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(-50.0..50.0), rng.gen_range(-50.0..50.0), -6000.0]).collect();
+        let grad: Vec<[f64; 3]> =
+            (0..n).map(|_| [rng.gen_range(-50.0..50.0), rng.gen_range(-50.0..50.0), -6000.0]).collect();
         let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
         let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
         let m = 5000;
@@ -284,7 +309,8 @@ mod tests {
                 [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
             })
             .collect();
-        let vel: Vec<[f64; 3]> = (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
+        let vel: Vec<[f64; 3]> =
+            (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
         let (mut f, mut cf) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
         let d = 1.2e-3;
         Exchange::new(&g, pos.len()).particle_gas_forces(&g, &gas, 1.8e-5, 0.1, d, &pos, &vel, &mut f, &mut cf);
@@ -321,7 +347,8 @@ mod tests {
         let g = grid();
         let n = g.num_cells();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
-        let vel_c: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
+        let vel_c: Vec<[f64; 3]> =
+            (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
         let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
         let grad = vec![[0.0, 0.0, -5000.0]; n];
         let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();

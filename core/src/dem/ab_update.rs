@@ -57,7 +57,8 @@ unsafe fn moved_avx512(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], ol
         let m: __mmask8 = if n - k >= 8 { 0xff } else { (1u8 << (n - k)) - 1 };
         let fk = _mm512_maskz_loadu_pd(m, pf.add(k));
         let (f1, f2) = (_mm512_maskz_loadu_pd(m, pn.add(k)), _mm512_maskz_loadu_pd(m, po.add(k)));
-        let inc = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(h[0], fk), _mm512_mul_pd(h[1], f1)), _mm512_mul_pd(h[2], f2));
+        let inc =
+            _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(h[0], fk), _mm512_mul_pd(h[1], f1)), _mm512_mul_pd(h[2], f2));
         let yk = _mm512_add_pd(_mm512_maskz_loadu_pd(m, py.add(k)), inc);
         _mm512_mask_storeu_pd(py.add(k), m, yk);
         _mm512_mask_storeu_pd(po.add(k), m, fk);
@@ -100,7 +101,11 @@ mod tests {
                 inc_max = inc_max.max((ya[k] - y0[k]).abs());
                 y_max = y_max.max(ya[k].abs());
             }
-            assert!((want.0 - inc_max).abs() <= 1e-12 * inc_max.max(1e-300) + 1e-15, "n = {n}: {} against {inc_max}", want.0);
+            assert!(
+                (want.0 - inc_max).abs() <= 1e-12 * inc_max.max(1e-300) + 1e-15,
+                "n = {n}: {} against {inc_max}",
+                want.0
+            );
             assert_eq!(want.1, y_max, "n = {n}");
         }
     }

@@ -94,7 +94,7 @@ pub fn contact_force<const FRICTION: bool>(
     let vn = dot(vrel, n); // dδ/dt, > 0 while approaching
     let sd = delta.sqrt();
     let qd = sd.sqrt(); // δ^{1/4} without powf
-    // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt, clamped ≥ 0 (PHYSICS.md 2.2)
+                        // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt, clamped ≥ 0 (PHYSICS.md 2.2)
     let fnorm = law.kn * delta * sd + law.dn * qd * vn;
     let fnorm = if law.no_tension { fnorm.max(0.0) } else { fnorm };
     let mut f = [-fnorm * n[0], -fnorm * n[1], -fnorm * n[2]];

@@ -9,12 +9,12 @@
 //! This file holds the shared types and pass 1. `team_step` runs both passes as one broadcast
 //! (the multistep steps); `pair_pass` alone serves the start-up and the fallback.
 
+use super::contact::{ContactLaw, V3};
+use super::neighbors::{Hist, NeighborList};
 use super::pair_batch::{Batch, CAP};
 use super::pair_scatter::{scatter, PairSum};
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{scan8, LANES};
-use super::contact::{ContactLaw, V3};
-use super::neighbors::{Hist, NeighborList};
 pub use super::work_split::Scratch;
 use super::DemParams;
 use rayon::prelude::*;
@@ -58,7 +58,8 @@ pub struct Stats {
 }
 
 impl Stats {
-    pub const ZERO: Stats = Stats { overlap: 0.0, coulomb_excess: f64::NEG_INFINITY, disp2: 0.0, moved: 0.0, extent: 0.0 };
+    pub const ZERO: Stats =
+        Stats { overlap: 0.0, coulomb_excess: f64::NEG_INFINITY, disp2: 0.0, moved: 0.0, extent: 0.0 };
     pub fn max(self, o: Stats) -> Stats {
         Stats {
             overlap: self.overlap.max(o.overlap),
@@ -107,7 +108,8 @@ pub fn pair_pass<const FR: bool>(
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
-            let args = ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
+            let args =
+                ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
             match kernels {
                 Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
                 Kernels::Portable => chunk_pairs::<FR, false>(&args, sh, to, acc),
@@ -135,7 +137,12 @@ pub(super) struct ChunkArgs<'a> {
     pub w: &'a [V3],
 }
 
-pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
+pub(super) fn chunk_pairs_dispatch<const FR: bool>(
+    c: &ChunkArgs,
+    sh: &mut [Hist],
+    to: &mut [u8],
+    acc: &mut [PairSum],
+) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f")
@@ -155,13 +162,23 @@ pub(super) fn chunk_pairs_dispatch<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
-unsafe fn chunk_pairs_avx512<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
+unsafe fn chunk_pairs_avx512<const FR: bool>(
+    c: &ChunkArgs,
+    sh: &mut [Hist],
+    to: &mut [u8],
+    acc: &mut [PairSum],
+) -> Stats {
     chunk_pairs::<FR, true>(c, sh, to, acc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
+unsafe fn chunk_pairs_avx2<const FR: bool>(
+    c: &ChunkArgs,
+    sh: &mut [Hist],
+    to: &mut [u8],
+    acc: &mut [PairSum],
+) -> Stats {
     chunk_pairs::<FR, false>(c, sh, to, acc)
 }
 
@@ -169,7 +186,12 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &
 /// added into `acc` (particles a..). Particles are read only in the window a..e, and the batch
 /// lanes hold indices into it (particle − a).
 #[inline(always)]
-fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to: &mut [u8], acc: &mut [PairSum]) -> Stats {
+fn chunk_pairs<const FR: bool, const V: bool>(
+    c: &ChunkArgs,
+    sh: &mut [Hist],
+    to: &mut [u8],
+    acc: &mut [PairSum],
+) -> Stats {
     let &ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
     acc.fill(PairSum::default());
     let mut st = Stats::ZERO;
@@ -232,8 +254,17 @@ fn chunk_pairs<const FR: bool, const V: bool>(c: &ChunkArgs, sh: &mut [Hist], to
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
-    batch: &mut Batch, law: &ContactLaw, audit: bool, r: f64, h: f64, v: &[V3], w: &[V3], sh: &mut [Hist], base: usize,
-    acc: &mut [PairSum], st: &mut Stats,
+    batch: &mut Batch,
+    law: &ContactLaw,
+    audit: bool,
+    r: f64,
+    h: f64,
+    v: &[V3],
+    w: &[V3],
+    sh: &mut [Hist],
+    base: usize,
+    acc: &mut [PairSum],
+    st: &mut Stats,
 ) {
     let (ov, ex) = batch.evaluate::<FR, V>(law, audit, r, h, v, w, sh, base);
     st.overlap = st.overlap.max(ov);

@@ -50,7 +50,15 @@ impl NearList {
     /// `outer`: 0 left out, 1 kept with `outer`'s history (none, under `Histories::Near`),
     /// p + 2 kept with the old near entry p's. Two parallel sweeps: codes and row counts, then
     /// the rows copied into place.
-    pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories, code: &mut Vec<u32>) {
+    pub fn select_into(
+        &mut self,
+        outer: &NeighborList,
+        x: &[V3],
+        diameter: f64,
+        gap: f64,
+        hist: Histories,
+        code: &mut Vec<u32>,
+    ) {
         let n = outer.offsets.len().saturating_sub(1);
         let total_in = outer.nbr.len();
         assert!(x.len() == n, "one position per list row");
@@ -58,7 +66,10 @@ impl NearList {
         let empty = NearList::default();
         let old = match hist {
             Histories::Near(old) => {
-                assert!(old.list.offsets.len() == n + 1 && old.src.len() == old.list.nbr.len(), "near list of another list");
+                assert!(
+                    old.list.offsets.len() == n + 1 && old.src.len() == old.list.nbr.len(),
+                    "near list of another list"
+                );
                 assert!(old.list.nbr.len() <= u32::MAX as usize - 2, "list too long");
                 old
             }
@@ -88,7 +99,8 @@ impl NearList {
             for i in r.clone() {
                 let xi = x[i];
                 // Cursor over the old near row i, a subsequence of the list row.
-                let (mut p, p_end) = if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
+                let (mut p, p_end) =
+                    if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
                 for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
                     let matched = p < p_end && old.src[p] as usize == k;
                     let live = if from_old { matched && old.list.touch[p] != 0 } else { outer.touch[k] != 0 };
@@ -146,4 +158,3 @@ impl NearList {
         });
     }
 }
-

@@ -90,7 +90,15 @@ impl Batch {
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     pub fn evaluate<const FR: bool, const V: bool>(
-        &mut self, law: &ContactLaw, audit: bool, r: f64, h: f64, v: &[V3], w: &[V3], shear: &mut [Hist], base: usize,
+        &mut self,
+        law: &ContactLaw,
+        audit: bool,
+        r: f64,
+        h: f64,
+        v: &[V3],
+        w: &[V3],
+        shear: &mut [Hist],
+        base: usize,
     ) -> (f64, f64) {
         let m = self.m.min(CAP);
         let n = v.len();
@@ -135,7 +143,8 @@ impl Batch {
         if !FR {
             return (max_delta, f64::NEG_INFINITY);
         }
-        let max_excess = if audit { lane_max(m, f32::NEG_INFINITY, |l| self.excess[l]) as f64 } else { f64::NEG_INFINITY };
+        let max_excess =
+            if audit { lane_max(m, f32::NEG_INFINITY, |l| self.excess[l]) as f64 } else { f64::NEG_INFINITY };
         let mut l0 = 0;
         #[cfg(target_arch = "x86_64")]
         if V {
@@ -192,7 +201,8 @@ fn lanes<const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: 
     // nobody reads. A count of b.m left the compiler a scalar tail of lanes per batch, each
     // several times the cost of a vector lane (docs/BENCHMARKS.md, "The lane loop's scalar tail").
     let m = ((b.m.min(CAP) + 15) & !15).min(CAP);
-    let (kn, dn, ktl, dtl, mu, nt) = (law.kn as f32, law.dn as f32, law.kt as f32, law.dt as f32, law.mu as f32, law.no_tension);
+    let (kn, dn, ktl, dtl, mu, nt) =
+        (law.kn as f32, law.dn as f32, law.kt as f32, law.dt as f32, law.mu as f32, law.no_tension);
     let (d1, h) = (d as f32, h as f32);
     for l in 0..m {
         let dist = b.r2[l].sqrt();

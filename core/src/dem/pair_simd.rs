@@ -33,7 +33,15 @@ pub const LANES: usize = 8;
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn scan8<const FR: bool>(
-    k: usize, base: usize, first: usize, owner: &[u32], nbr: &[u32], x: &[V3], d2: f64, to: &mut [u8], batch: &mut Batch,
+    k: usize,
+    base: usize,
+    first: usize,
+    owner: &[u32],
+    nbr: &[u32],
+    x: &[V3],
+    d2: f64,
+    to: &mut [u8],
+    batch: &mut Batch,
     m: usize,
 ) -> usize {
     debug_assert!(k + LANES <= owner.len() && k + LANES <= nbr.len() && m <= CAP - LANES);
@@ -53,7 +61,10 @@ pub unsafe fn scan8<const FR: bool>(
         *d = _mm512_sub_pd(xj, xi);
     }
     // r² = (dx₀² + dx₁²) + dx₂², as the scalar scan.
-    let r2 = _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(dx[0], dx[0]), _mm512_mul_pd(dx[1], dx[1])), _mm512_mul_pd(dx[2], dx[2]));
+    let r2 = _mm512_add_pd(
+        _mm512_add_pd(_mm512_mul_pd(dx[0], dx[0]), _mm512_mul_pd(dx[1], dx[1])),
+        _mm512_mul_pd(dx[2], dx[2]),
+    );
     let d2v = _mm512_set1_pd(d2);
     let touch: __mmask8 = _mm512_cmp_pd_mask::<_CMP_LT_OQ>(r2, d2v);
     const BYTES: u64 = 0x0101_0101_0101_0101;
@@ -71,7 +82,9 @@ pub unsafe fn scan8<const FR: bool>(
     _mm256_storeu_si256(batch.i.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oi));
     _mm256_storeu_si256(batch.j.as_mut_ptr().add(m) as *mut __m256i, _mm256_maskz_compress_epi32(touch, oj));
     // Rounded to single precision as `Batch::set` does.
-    let put = |lanes: &mut [f32; CAP], d: __m512d| _mm256_storeu_ps(lanes.as_mut_ptr().add(m), _mm256_maskz_compress_ps(touch, _mm512_cvtpd_ps(d)));
+    let put = |lanes: &mut [f32; CAP], d: __m512d| {
+        _mm256_storeu_ps(lanes.as_mut_ptr().add(m), _mm256_maskz_compress_ps(touch, _mm512_cvtpd_ps(d)))
+    };
     for (a, d) in dx.iter().enumerate() {
         put(&mut batch.dx[a], *d);
     }
@@ -91,7 +104,14 @@ pub unsafe fn scan8<const FR: bool>(
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 #[allow(clippy::too_many_arguments)]
 pub unsafe fn gather8<const FR: bool>(
-    batch: &mut Batch, l: usize, valid: __mmask8, r: f64, v: &[V3], w: &[V3], shear: &[Hist], base: usize,
+    batch: &mut Batch,
+    l: usize,
+    valid: __mmask8,
+    r: f64,
+    v: &[V3],
+    w: &[V3],
+    shear: &[Hist],
+    base: usize,
 ) {
     debug_assert!(l + LANES <= CAP);
     let three = |a: __m256i| _mm256_add_epi32(_mm256_add_epi32(a, a), a);
@@ -116,7 +136,8 @@ pub unsafe fn gather8<const FR: bool>(
         return;
     }
     let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f32, _mm512_set1_pd(r));
-    let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let kk =
+        _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
     // k < base wraps to a large unsigned value, so one compare checks both ends.
     assert!(below(kk, shear.len()) & valid == valid, "history slot beyond the chunk");
     let tk = three(kk);
@@ -143,7 +164,8 @@ pub unsafe fn gather8<const FR: bool>(
 #[inline(always)]
 pub unsafe fn write_back8(batch: &Batch, l: usize, valid: __mmask8, shear: &mut [Hist], base: usize) {
     debug_assert!(l + LANES <= CAP);
-    let kk = _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let kk =
+        _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
     let inside = _mm256_cmplt_epu32_mask(kk, _mm256_set1_epi32(shear.len() as i32));
     assert!(inside & valid == valid, "history slot beyond the chunk");
     let tk = _mm256_add_epi32(_mm256_add_epi32(kk, kk), kk);
@@ -229,7 +251,10 @@ impl Slots {
     unsafe fn new(p: *const f32, k0: usize, kl: usize, len: usize, t: __m256i, valid: __mmask8) -> Slots {
         let near = if kl.wrapping_sub(k0) <= 9 && 3 * k0 + 32 <= 3 * len {
             let at = p.add(3 * k0);
-            Some(([_mm512_loadu_ps(at), _mm512_loadu_ps(at.add(16))], _mm256_sub_epi32(t, _mm256_set1_epi32(3 * k0 as i32))))
+            Some((
+                [_mm512_loadu_ps(at), _mm512_loadu_ps(at.add(16))],
+                _mm256_sub_epi32(t, _mm256_set1_epi32(3 * k0 as i32)),
+            ))
         } else {
             None
         };
@@ -288,8 +313,14 @@ mod tests {
                     let got_hist: [f32; 8] = std::mem::transmute(s.component(q));
                     for lane in 0..8 {
                         let want = if mask >> lane & 1 == 1 { data[rows[lane]][q] } else { 0.0 };
-                        assert_eq!(got[lane], want, "case {case}: span {span}, first row {i0}, lane {lane}, component {q}");
-                        assert_eq!(got_hist[lane] as f64, want, "histories: case {case}, span {span}, lane {lane}, component {q}");
+                        assert_eq!(
+                            got[lane], want,
+                            "case {case}: span {span}, first row {i0}, lane {lane}, component {q}"
+                        );
+                        assert_eq!(
+                            got_hist[lane] as f64, want,
+                            "histories: case {case}, span {span}, lane {lane}, component {q}"
+                        );
                     }
                 }
             }

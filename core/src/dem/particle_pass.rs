@@ -6,8 +6,8 @@
 use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::{dist2, V3};
 use super::forces::{Acc, Past, Stats};
-use super::work_split::Sums;
 use super::walls::{wall_forces, WallList};
+use super::work_split::Sums;
 use super::DemParams;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -32,8 +32,17 @@ fn written<T: Copy>(out: &mut [MaybeUninit<T>], mut row: impl FnMut(usize) -> T)
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn block_forces<'o, const FR: bool>(
-    p: &DemParams, lo: usize, x: &[V3], v: &[V3], w: &[V3], ext: &[V3], sc: Sums, widx: &[u32],
-    whist: &mut [[V3; 3]], out: &'o mut [MaybeUninit<Acc>], st: &mut Stats,
+    p: &DemParams,
+    lo: usize,
+    x: &[V3],
+    v: &[V3],
+    w: &[V3],
+    ext: &[V3],
+    sc: Sums,
+    widx: &[u32],
+    whist: &mut [[V3; 3]],
+    out: &'o mut [MaybeUninit<Acc>],
+    st: &mut Stats,
 ) -> &'o mut [Acc] {
     let hi = lo + out.len();
     // A scene without gas skips the stream of zeros (1–5% of a step, docs/BENCHMARKS.md).
@@ -75,7 +84,11 @@ fn accel_of(p: &DemParams, o: &Acc, vi: V3) -> V3 {
 #[inline(always)]
 fn alpha_of<const FR: bool>(p: &DemParams, o: &Acc, wi: V3) -> V3 {
     let (ii, g) = (p.radius / p.inertia, p.extra_damping);
-    if FR { [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]] } else { [0.0; 3] }
+    if FR {
+        [o[3] * ii - g * wi[0], o[4] * ii - g * wi[1], o[5] * ii - g * wi[2]]
+    } else {
+        [0.0; 3]
+    }
 }
 
 /// The wall-list entries (sorted by particle) of block b of n particles.
@@ -100,7 +113,14 @@ fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> 
 /// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
 #[allow(clippy::too_many_arguments)]
 pub fn accel_pass<const FR: bool>(
-    p: &DemParams, x: &[V3], v: &[V3], w: &[V3], walls: &mut WallList, ext: &[V3], sc: Sums, out: &mut [Acc],
+    p: &DemParams,
+    x: &[V3],
+    v: &[V3],
+    w: &[V3],
+    walls: &mut WallList,
+    ext: &[V3],
+    sc: Sums,
+    out: &mut [Acc],
 ) -> Stats {
     let wb = wall_blocks(walls, x.len());
     out.par_chunks_mut(BLOCK)
@@ -178,7 +198,14 @@ pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: 
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-pub(super) fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
+pub(super) fn update_block_dispatch<const FR: bool>(
+    p: &DemParams,
+    hb: [f64; 3],
+    bm: BlockMotion,
+    xb: &[V3],
+    ext: &[V3],
+    sc: Sums,
+) -> Stats {
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx512f") {
@@ -195,18 +222,39 @@ pub(super) fn update_block_dispatch<const FR: bool>(p: &DemParams, hb: [f64; 3],
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f")]
-unsafe fn update_block_avx512<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
+unsafe fn update_block_avx512<const FR: bool>(
+    p: &DemParams,
+    hb: [f64; 3],
+    bm: BlockMotion,
+    xb: &[V3],
+    ext: &[V3],
+    sc: Sums,
+) -> Stats {
     update_block::<FR>(p, hb, bm, xb, ext, sc)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn update_block_avx2<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, xb: &[V3], ext: &[V3], sc: Sums) -> Stats {
+unsafe fn update_block_avx2<const FR: bool>(
+    p: &DemParams,
+    hb: [f64; 3],
+    bm: BlockMotion,
+    xb: &[V3],
+    ext: &[V3],
+    sc: Sums,
+) -> Stats {
     update_block::<FR>(p, hb, bm, xb, ext, sc)
 }
 
 #[inline(always)]
-fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_ref: &[V3], ext: &[V3], sc: Sums) -> Stats {
+fn update_block<const FR: bool>(
+    p: &DemParams,
+    hb: [f64; 3],
+    bm: BlockMotion,
+    x_ref: &[V3],
+    ext: &[V3],
+    sc: Sums,
+) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
     let len = x.len();
     let mut st = Stats::ZERO;
@@ -219,7 +267,8 @@ fn update_block<const FR: bool>(p: &DemParams, hb: [f64; 3], bm: BlockMotion, x_
     let [ov, oa, ow] = older;
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();
-    (st.moved, st.extent) = ab_flat_moved(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
+    (st.moved, st.extent) =
+        ab_flat_moved(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
     ab_flat(hb, v.as_flattened_mut(), a.as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al.as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());

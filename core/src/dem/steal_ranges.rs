@@ -19,7 +19,10 @@ impl StealRanges {
     pub fn new(n: usize, threads: usize, own_from_back: bool) -> Self {
         assert!(n < u32::MAX as usize && threads > 0, "{n} items over {threads} threads");
         let bound = |t: usize| (t * n / threads) as u64;
-        StealRanges { left: (0..threads).map(|t| AtomicU64::new(bound(t + 1) << 32 | bound(t))).collect(), own_from_back }
+        StealRanges {
+            left: (0..threads).map(|t| AtomicU64::new(bound(t + 1) << 32 | bound(t))).collect(),
+            own_from_back,
+        }
     }
 
     /// The next item for thread t: from its own range, else from the next non-empty one.
@@ -67,7 +70,14 @@ mod tests {
         for (n, threads, back) in [(1000, 4, false), (1000, 4, true), (7, 3, true), (0, 2, false), (3, 5, true)] {
             let q = StealRanges::new(n, threads, back);
             let taken: Vec<Vec<usize>> = std::thread::scope(|s| {
-                let hs: Vec<_> = (0..threads).map(|t| s.spawn({ let q = &q; move || std::iter::from_fn(|| q.take(t)).collect::<Vec<_>>() })).collect();
+                let hs: Vec<_> = (0..threads)
+                    .map(|t| {
+                        s.spawn({
+                            let q = &q;
+                            move || std::iter::from_fn(|| q.take(t)).collect::<Vec<_>>()
+                        })
+                    })
+                    .collect();
                 hs.into_iter().map(|h| h.join().unwrap()).collect()
             });
             let mut all: Vec<usize> = taken.concat();

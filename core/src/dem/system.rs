@@ -6,11 +6,11 @@
 
 use super::contact::{dist2, V3};
 use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
-use super::particle_pass::{accel_pass, update_pass, Motion};
-use super::team_step::{team_step, StepState, TeamLock};
 use super::integrator::weights;
 use super::near_list::{Histories, NearList};
 use super::neighbors::{build_list, cell_order, NeighborList};
+use super::particle_pass::{accel_pass, update_pass, Motion};
+use super::team_step::{team_step, StepState, TeamLock};
 use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
@@ -272,7 +272,8 @@ impl DemSystem {
         let exact = self.levels == 0 || self.moved_bound + 2.0 * SQRT_3 * self.last_move >= safe;
         let x_ref = if exact { &self.x_near[..] } else { &[] };
         let st = if self.levels == 0 {
-            let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+            let st1 =
+                pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
             let st = st1.max(self.heun::<FR>());
             self.sc.bounds.clear(); // replanned at the next step, now with the contacts' flags
             st
@@ -296,7 +297,15 @@ impl DemSystem {
                 }
                 // Two parallel loops, which cannot wait on another team's threads.
                 None => {
-                    let st1 = pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+                    let st1 = pair_pass::<FR>(
+                        &self.p,
+                        &self.x,
+                        &self.v,
+                        &self.w,
+                        &mut self.near.list,
+                        &mut self.sc,
+                        Kernels::Best,
+                    );
                     let m = Motion {
                         x: &mut self.x,
                         v: &mut self.v,
@@ -348,7 +357,14 @@ impl DemSystem {
             return;
         }
         let (spare, code) = &mut self.spare;
-        spare.select_into(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), Histories::Near(&self.near), code);
+        spare.select_into(
+            &self.outer,
+            &self.x,
+            2.0 * self.p.radius,
+            self.p.near_gap(),
+            Histories::Near(&self.near),
+            code,
+        );
         std::mem::swap(&mut self.near, spare);
         self.sc.bounds.clear(); // replanned for the new list at the next step
         self.x_near.clone_from(&self.x);
@@ -373,7 +389,8 @@ impl DemSystem {
         let n = self.x.len();
         let h = self.p.dt;
         let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
-        let st = accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
+        let st =
+            accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
         let nl = &self.near.list;
         let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());

@@ -10,8 +10,8 @@
 
 use super::contact::V3;
 use super::forces::{chunk_pairs_dispatch, ChunkArgs, Past, Scratch, Stats};
-use super::pair_scatter::PairSum;
 use super::neighbors::{Hist, NeighborList};
+use super::pair_scatter::PairSum;
 use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
 use super::steal_ranges::StealRanges;
 use super::walls::WallList;
@@ -134,10 +134,19 @@ pub struct StepState<'a> {
 
 /// The pair pass and the fused particle pass of one step: weights `hb` (= h·b), newer past
 /// slot `ring`, displacements measured from `x_ref` (unless it is empty).
-pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: StepState, x_ref: &[V3], ext: &[V3]) -> Stats {
+pub fn team_step<const FR: bool>(
+    p: &DemParams,
+    hb: [f64; 3],
+    ring: usize,
+    s: StepState,
+    x_ref: &[V3],
+    ext: &[V3],
+) -> Stats {
     let StepState { x, v, w, past, walls, nl, sc } = s;
     let n = x.len();
-    assert!(v.len() == n && w.len() == n && (x_ref.is_empty() || x_ref.len() == n) && (ext.is_empty() || ext.len() == n));
+    assert!(
+        v.len() == n && w.len() == n && (x_ref.is_empty() || x_ref.len() == n) && (ext.is_empty() || ext.len() == n)
+    );
     assert!(past.v.iter().chain(&past.a).chain(&past.alpha).all(|s| s.len() == n), "past derivatives");
     let (offsets, nbr) = (&nl.offsets[..], &nl.nbr[..]);
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
@@ -176,9 +185,13 @@ pub fn team_step<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, s: St
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
-                let args = ChunkArgs { law: &p.pair, audit: p.audit, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
+                let args =
+                    ChunkArgs { law: &p.pair, audit: p.audit, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
                 #[cfg(test)]
-                assert!(PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1 || has_own_team(), "injected panic in chunk {c}");
+                assert!(
+                    PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1 || has_own_team(),
+                    "injected panic in chunk {c}"
+                );
                 st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
                 done[c].store(true, Ordering::Release);
             }

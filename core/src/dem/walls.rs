@@ -55,7 +55,16 @@ impl WallList {
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn wall_contact<const FR: bool>(
-    law: &ContactLaw, audit: bool, r: f64, h: f64, k: usize, delta: f64, nrm: V3, vi: V3, wi: V3, hist: &mut V3,
+    law: &ContactLaw,
+    audit: bool,
+    r: f64,
+    h: f64,
+    k: usize,
+    delta: f64,
+    nrm: V3,
+    vi: V3,
+    wi: V3,
+    hist: &mut V3,
     on: &mut impl FnMut(usize, &[f64; 6]),
 ) -> (f64, f64) {
     if delta <= 0.0 {
@@ -71,7 +80,14 @@ fn wall_contact<const FR: bool>(
 /// Every wall contact of a particle at `xi`: wall k (0 plate, 1 tube, 2 lid) hands its force
 /// and n × F_t to `on`; returns the largest overlap and Coulomb excess.
 #[inline(always)]
-fn each_wall<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], mut on: impl FnMut(usize, &[f64; 6])) -> (f64, f64) {
+fn each_wall<const FR: bool>(
+    p: &DemParams,
+    xi: V3,
+    vi: V3,
+    wi: V3,
+    hist: &mut [V3; 3],
+    mut on: impl FnMut(usize, &[f64; 6]),
+) -> (f64, f64) {
     let (law, audit, r, h) = (&p.wall, p.audit, p.radius, p.dt);
     let [h0, h1, h2] = hist;
     // Distributor plate z = 0: normal (0,0,−1).
@@ -88,7 +104,8 @@ fn each_wall<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [
         *h1 = [0.0; 3];
     }
     if p.lid {
-        let (o, e) = wall_contact::<FR>(law, audit, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
+        let (o, e) =
+            wall_contact::<FR>(law, audit, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     }
     (ov, ex)
@@ -97,7 +114,14 @@ fn each_wall<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [
 /// All wall forces on a particle at `xi` (force and n × F_t summed into `acc`); returns the
 /// largest overlap and Coulomb excess.
 #[inline]
-pub fn wall_forces<const FR: bool>(p: &DemParams, xi: V3, vi: V3, wi: V3, hist: &mut [V3; 3], acc: &mut [f64; 6]) -> (f64, f64) {
+pub fn wall_forces<const FR: bool>(
+    p: &DemParams,
+    xi: V3,
+    vi: V3,
+    wi: V3,
+    hist: &mut [V3; 3],
+    acc: &mut [f64; 6],
+) -> (f64, f64) {
     each_wall::<FR>(p, xi, vi, wi, hist, |_, fc| {
         for (a, f) in acc.iter_mut().zip(fc) {
             *a += f;

@@ -1,8 +1,8 @@
 //! The work split of the pair pass (`Scratch`): contiguous particle chunks of about equal work,
 //! each with a private force buffer, planned once per neighbour-list build.
 
-use super::pair_scatter::PairSum;
 use super::neighbors::NeighborList;
+use super::pair_scatter::PairSum;
 use rayon::prelude::*;
 
 /// Extra work units of a touching pair over a listed one in the chunk cuts. Timed per thread
@@ -52,7 +52,10 @@ impl<'a> Sums<'a> {
     /// `acc` points to `len` buffers rows valid for 'a, and no row read through `rows` is
     /// written while the returned slice lives.
     pub unsafe fn from_raw(bounds: &'a [[usize; 3]], start: &'a [usize], acc: *const PairSum, len: usize) -> Self {
-        assert!(start.len() > bounds.len() && bounds.iter().zip(start).all(|(&[a, _, e], &s)| s + e - a <= len), "chunk buffers");
+        assert!(
+            start.len() > bounds.len() && bounds.iter().zip(start).all(|(&[a, _, e], &s)| s + e - a <= len),
+            "chunk buffers"
+        );
         Sums { bounds, start, acc, len, life: std::marker::PhantomData }
     }
 
@@ -84,7 +87,10 @@ impl Scratch {
         // The pair pass indexes without bounds checks: check the list once here (it may come
         // from a checkpoint) — rows ascending within 0..n, histories and flags one per entry.
         let total = nl.nbr.len();
-        assert!(nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total, "neighbour list shape");
+        assert!(
+            nl.offsets.len() == n + 1 && nl.offsets[0] == 0 && nl.offsets[n] as usize == total,
+            "neighbour list shape"
+        );
         assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
         assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
@@ -102,7 +108,11 @@ impl Scratch {
             let (mut lo, mut hi) = (0, n);
             while lo < hi {
                 let mid = (lo + hi) / 2;
-                if work(mid) * nc < c * work(n) { lo = mid + 1 } else { hi = mid }
+                if work(mid) * nc < c * work(n) {
+                    lo = mid + 1
+                } else {
+                    hi = mid
+                }
             }
             lo
         };

@@ -163,7 +163,13 @@ impl CylGrid {
         let (k, c) = (idx / per, idx % per);
         let i = ((c / self.n0) as f64).sqrt() as usize;
         // Guard the float square root at annulus boundaries.
-        let i = if self.offset[i + 1] <= c { i + 1 } else if self.offset[i] > c { i - 1 } else { i };
+        let i = if self.offset[i + 1] <= c {
+            i + 1
+        } else if self.offset[i] > c {
+            i - 1
+        } else {
+            i
+        };
         (i, c - self.offset[i], k)
     }
     /// (i, j) of the column through a horizontal point; O(1). Points beyond the wall map to the

@@ -113,7 +113,14 @@ fn locate_near_agrees_with_locate_for_any_hint() {
         }
         let (x, y) = (r * th.cos(), r * th.sin());
         let exact = g.locate(x, y, z);
-        let hints = [exact, exact + 1, exact.wrapping_sub(1), exact + g.cells_per_layer(), (rnd() * g.num_cells() as f64) as usize, usize::MAX];
+        let hints = [
+            exact,
+            exact + 1,
+            exact.wrapping_sub(1),
+            exact + g.cells_per_layer(),
+            (rnd() * g.num_cells() as f64) as usize,
+            usize::MAX,
+        ];
         for h in hints {
             assert_eq!(g.locate_near(x, y, z, h), exact, "point ({x}, {y}, {z}) with hint {h}");
             total += 1;

@@ -36,7 +36,8 @@ pub fn decode_f64(bytes: &[u8]) -> Option<(Vec<usize>, Vec<f64>)> {
         return None;
     }
     let s = header.split("'shape': (").nth(1)?.split(')').next()?;
-    let shape: Vec<usize> = s.split(',').map(str::trim).filter(|t| !t.is_empty()).map(|t| t.parse().ok()).collect::<Option<_>>()?;
+    let shape: Vec<usize> =
+        s.split(',').map(str::trim).filter(|t| !t.is_empty()).map(|t| t.parse().ok()).collect::<Option<_>>()?;
     let data: Vec<f64> =
         bytes[10 + hlen..].chunks_exact(8).map(|c| f64::from_le_bytes(c.try_into().expect("8 bytes"))).collect();
     (data.len() == shape.iter().product::<usize>()).then_some((shape, data))

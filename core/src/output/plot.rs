@@ -65,14 +65,18 @@ pub fn trace_marked(t: &[f64], y: &[f64], level: Option<f64>, at: Option<f64>) -
     let (pw, ph) = (w - left - right, h - top - bottom);
     img.line((left, top), (left, top + ph), BLACK);
     img.line((left, top + ph), (left + pw, top + ph), BLACK);
-    let pts: Vec<(f64, f64)> = t.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect();
+    let pts: Vec<(f64, f64)> =
+        t.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect();
     if pts.is_empty() {
         return img;
     }
     let (t0, t1) = span(pts.iter().map(|p| p.0).chain(at.filter(|a| a.is_finite())));
     let (y0, y1) = span(pts.iter().map(|p| p.1).chain(level.filter(|l| l.is_finite())));
     let to_px = |(a, b): (f64, f64)| {
-        (left + ((a - t0) / (t1 - t0) * pw as f64).round() as i64, top + ph - ((b - y0) / (y1 - y0) * ph as f64).round() as i64)
+        (
+            left + ((a - t0) / (t1 - t0) * pw as f64).round() as i64,
+            top + ph - ((b - y0) / (y1 - y0) * ph as f64).round() as i64,
+        )
     };
     if let Some(l) = level.filter(|l| l.is_finite()) {
         let (_, yy) = to_px((t0, l));

@@ -15,7 +15,11 @@ fn snapshot_with_particles(positions: Vec<[f64; 3]>) -> Snapshot {
         gas_velocity_m_s: None,
         pressure_drop_pa: None,
         layer_pressure_drop_pa: None,
-        particles: Some(ParticleSnapshot { radius_m: 0.0006, positions_m: positions, velocities_m_s: vec![[0.0; 3]; n] }),
+        particles: Some(ParticleSnapshot {
+            radius_m: 0.0006,
+            positions_m: positions,
+            velocities_m_s: vec![[0.0; 3]; n],
+        }),
     }
 }
 
@@ -43,8 +47,12 @@ fn png_crc_matches_the_specification_value_for_iend() {
 #[test]
 fn direct_voidage_conserves_particle_volume() {
     // Σ(1 − ε)·V_cell = N·V_p (paper eq. 2 puts each particle whole into one cell).
-    let positions: Vec<[f64; 3]> =
-        (0..200).map(|n| { let t = n as f64 * 0.7; [0.015 * (n as f64 / 200.0) * t.cos(), 0.015 * (n as f64 / 200.0) * t.sin(), 0.001 + 0.0002 * n as f64] }).collect();
+    let positions: Vec<[f64; 3]> = (0..200)
+        .map(|n| {
+            let t = n as f64 * 0.7;
+            [0.015 * (n as f64 / 200.0) * t.cos(), 0.015 * (n as f64 / 200.0) * t.sin(), 0.001 + 0.0002 * n as f64]
+        })
+        .collect();
     let s = snapshot_with_particles(positions);
     let eps = fields::voidage(&s).expect("voidage from particles");
     let vc = s.grid.cell_volume_m3;
@@ -60,7 +68,8 @@ fn vtk_grid_has_one_subcell_per_arc_segment_of_at_most_15_degrees() {
     // segments are polygons, so the summed hexahedron volume equals that sum, within 1 %.
     let grid = CylGrid::new(0.022, 0.06, 0.0044, 0.005, 3);
     let text = vtk::cells(&grid, "t", &[vtk::CellField::Scalars("voidage", &vec![1.0; grid.num_cells()])]);
-    let n_sub: usize = (0..grid.nr).map(|i| grid.cells_in_annulus(i) * vtk::segments(&grid, i)).sum::<usize>() * grid.nz;
+    let n_sub: usize =
+        (0..grid.nr).map(|i| grid.cells_in_annulus(i) * vtk::segments(&grid, i)).sum::<usize>() * grid.nz;
     assert!(text.contains(&format!("CELL_TYPES {n_sub}")));
     assert!(text.contains("SCALARS voidage double 1"));
     // Outer ring: segments of equal angle φ_i; polygon area = ½ r² · (number of segments) · sin φ.
@@ -72,7 +81,8 @@ fn vtk_grid_has_one_subcell_per_arc_segment_of_at_most_15_degrees() {
 
 #[test]
 fn axial_slice_shows_lower_voidage_where_particles_are() {
-    let positions: Vec<[f64; 3]> = (0..400).map(|n| [0.0001 * (n % 20) as f64 - 0.001, 0.0001 * (n / 20) as f64, 0.002]).collect();
+    let positions: Vec<[f64; 3]> =
+        (0..400).map(|n| [0.0001 * (n % 20) as f64 - 0.001, 0.0001 * (n / 20) as f64, 0.002]).collect();
     let s = snapshot_with_particles(positions);
     let eps = fields::voidage(&s).expect("voidage");
     let img = plot::axial_slice(&s.grid.grid(), &eps, 0.0, 1.0);

@@ -78,11 +78,26 @@ impl Simulation {
             b.cell_grad_p[c] = gas.pressure_gradient_cyl(c);
         }
         let g = self.st.case.gas.as_ref().expect("gas section");
-        let at = GasAtCells { velocity_cyl: &b.cell_velocity, density: &b.cell_density, grad_p_cyl: &b.cell_grad_p, voidage: &b.voidage };
+        let at = GasAtCells {
+            velocity_cyl: &b.cell_velocity,
+            density: &b.cell_density,
+            grad_p_cyl: &b.cell_grad_p,
+            voidage: &b.voidage,
+        };
         let dem = &self.st.dem;
         let d = 2.0 * dem.radius();
         if moving {
-            b.exchange.particle_gas_forces(&self.grid, &at, g.viscosity_pa_s, g.drag_voidage_min, d, dem.positions(), dem.velocities(), &mut b.particle_force, &mut b.cell_force);
+            b.exchange.particle_gas_forces(
+                &self.grid,
+                &at,
+                g.viscosity_pa_s,
+                g.drag_voidage_min,
+                d,
+                dem.positions(),
+                dem.velocities(),
+                &mut b.particle_force,
+                &mut b.cell_force,
+            );
             self.st.dem.external_forces_mut().copy_from_slice(&b.particle_force);
         } else {
             b.exchange.frozen_cell_forces(&self.grid, &at, g.viscosity_pa_s, g.drag_voidage_min, d, &mut b.cell_force);

@@ -21,7 +21,9 @@ fn lattice_case(diameter: f64, height: f64, bed_h: f64, s: f64, gas: Option<Gas>
         }
         z += a;
     }
-    let text = format!(r#"{{"column":{{"diameter_m":{diameter},"height_m":{height}}},"particles":{{}},"bed":{{"generated":{{}}}}}}"#);
+    let text = format!(
+        r#"{{"column":{{"diameter_m":{diameter},"height_m":{height}}},"particles":{{}},"bed":{{"generated":{{}}}}}}"#
+    );
     let mut c: Case = serde_json::from_str(&text).unwrap();
     c.bed = Bed::Explicit(ExplicitBed { positions_m: pos, velocities_m_s: None });
     c.gas = gas;

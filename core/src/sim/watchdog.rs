@@ -9,7 +9,9 @@ use crate::dem::DemSystem;
 pub const MAX_OVERLAP_FRACTION: f64 = 0.1;
 
 pub fn check_gas(gas: &GasSolver, dt: f64, t: f64) -> Result<(), SimError> {
-    gas.check_finite().map_err(|m| SimError::Unstable(format!("gas at t = {t:.6} s: {m}; lower gas.time_step_s or the superficial velocity")))?;
+    gas.check_finite().map_err(|m| {
+        SimError::Unstable(format!("gas at t = {t:.6} s: {m}; lower gas.time_step_s or the superficial velocity"))
+    })?;
     let stable = gas.stable_dt();
     if dt > stable * (1.0 + 1e-9) {
         return Err(SimError::Unstable(format!(
@@ -30,7 +32,10 @@ pub fn check_dem(dem: &DemSystem, steps: u64, t: f64) -> Result<(), SimError> {
     }
     if steps % 100 == 0 {
         if let Some(k) = dem.positions().iter().position(|p| !p.iter().all(|x| x.is_finite())) {
-            return Err(SimError::Unstable(format!("particle {} has a non-finite position at t = {t:.6} s; lower dem.time_step_s", dem.ids()[k])));
+            return Err(SimError::Unstable(format!(
+                "particle {} has a non-finite position at t = {t:.6} s; lower dem.time_step_s",
+                dem.ids()[k]
+            )));
         }
     }
     Ok(())

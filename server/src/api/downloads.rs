@@ -36,14 +36,23 @@ pub struct SnapshotQuery {
 
 fn bytes(content_type: &'static str, filename: String, body: Vec<u8>) -> Response {
     let disposition = format!("attachment; filename=\"{filename}\"");
-    ([(header::CONTENT_TYPE, content_type.to_string()), (header::CONTENT_DISPOSITION, disposition)], body).into_response()
+    ([(header::CONTENT_TYPE, content_type.to_string()), (header::CONTENT_DISPOSITION, disposition)], body)
+        .into_response()
 }
 
 fn missing(what: &str) -> Response {
-    problem(StatusCode::NOT_FOUND, "Field not stored", &format!("this snapshot has no {what} (see the case's outputs.fields)"))
+    problem(
+        StatusCode::NOT_FOUND,
+        "Field not stored",
+        &format!("this snapshot has no {what} (see the case's outputs.fields)"),
+    )
 }
 
-pub async fn one(State(app): State<Arc<App>>, Path((id, n)): Path<(String, String)>, Query(q): Query<SnapshotQuery>) -> Response {
+pub async fn one(
+    State(app): State<Arc<App>>,
+    Path((id, n)): Path<(String, String)>,
+    Query(q): Query<SnapshotQuery>,
+) -> Response {
     if let Err(r) = find(&app, &id) {
         return r;
     }
@@ -86,17 +95,34 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
         }
         "npy" if what == "particles" => match &s.particles {
             Some(p) => {
-                let data: Vec<f64> = p.positions_m.iter().zip(&p.velocities_m_s).flat_map(|(x, v)| [x[0], x[1], x[2], v[0], v[1], v[2]]).collect();
-                bytes("application/octet-stream", format!("particles_{n:06}.npy"), npy::encode_f64(&[p.positions_m.len(), 6], &data))
+                let data: Vec<f64> = p
+                    .positions_m
+                    .iter()
+                    .zip(&p.velocities_m_s)
+                    .flat_map(|(x, v)| [x[0], x[1], x[2], v[0], v[1], v[2]])
+                    .collect();
+                bytes(
+                    "application/octet-stream",
+                    format!("particles_{n:06}.npy"),
+                    npy::encode_f64(&[p.positions_m.len(), 6], &data),
+                )
             }
             None => missing("particles"),
         },
         "npy" => match cell_field(s, what) {
-            Some(f) => bytes("application/octet-stream", format!("{field_name}_{n:06}.npy"), npy::encode_f64(&[grid.nz, grid.cells_per_layer()], &f)),
+            Some(f) => bytes(
+                "application/octet-stream",
+                format!("{field_name}_{n:06}.npy"),
+                npy::encode_f64(&[grid.nz, grid.cells_per_layer()], &f),
+            ),
             None => missing(what),
         },
         "vtk" if what == "particles" => match &s.particles {
-            Some(p) => bytes("text/plain", format!("particles_{n:06}.vtk"), vtk::particles(p, &format!("fluidbed particles {n} t={} s", s.time_s)).into_bytes()),
+            Some(p) => bytes(
+                "text/plain",
+                format!("particles_{n:06}.vtk"),
+                vtk::particles(p, &format!("fluidbed particles {n} t={} s", s.time_s)).into_bytes(),
+            ),
             None => missing("particles"),
         },
         "vtk" => bytes("text/plain", format!("cells_{n:06}.vtk"), vtk::snapshot_cells(s).into_bytes()),
@@ -127,7 +153,11 @@ pub struct SeriesQuery {
 
 /// One row per snapshot: time_s, pressure_drop_pa (empty for runs without gas) and the mean
 /// particle-centre height (the bed-height proxy used for the plot of runs without gas).
-pub async fn pressure_drop(State(app): State<Arc<App>>, Path(id): Path<String>, Query(q): Query<SeriesQuery>) -> Response {
+pub async fn pressure_drop(
+    State(app): State<Arc<App>>,
+    Path(id): Path<String>,
+    Query(q): Query<SeriesQuery>,
+) -> Response {
     if let Err(r) = find(&app, &id) {
         return r;
     }

@@ -30,20 +30,35 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
         Err(e) => return problem(e.status(), "Unreadable request body", &e.body_text()),
     };
     if !app.take_submission_token() {
-        let mut r = problem(StatusCode::TOO_MANY_REQUESTS, "Too many submissions", "slow down: the server accepts a few jobs per second");
+        let mut r = problem(
+            StatusCode::TOO_MANY_REQUESTS,
+            "Too many submissions",
+            "slow down: the server accepts a few jobs per second",
+        );
         r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("1"));
         return r;
     }
     let value: serde_json::Value = match serde_json::from_slice(&body) {
         Ok(v) => v,
-        Err(e) => return problem(StatusCode::BAD_REQUEST, "Malformed JSON", &format!("the body is not valid JSON: {e}")),
+        Err(e) => {
+            return problem(StatusCode::BAD_REQUEST, "Malformed JSON", &format!("the body is not valid JSON: {e}"))
+        }
     };
     let (case, report) = match Case::parse_value(&value) {
         Ok(ok) => ok,
         Err(report) => {
-            let errors: Vec<_> = report.errors.iter().map(|p| json!({"pointer": p.path, "value": p.value, "allowed": p.allowed, "message": p.message})).collect();
+            let errors: Vec<_> = report
+                .errors
+                .iter()
+                .map(|p| json!({"pointer": p.path, "value": p.value, "allowed": p.allowed, "message": p.message}))
+                .collect();
             let detail = report.errors.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ");
-            return problem_with(StatusCode::UNPROCESSABLE_ENTITY, "Invalid case", &detail, json!({ "errors": errors, "warnings": problems_json(&report.warnings) }));
+            return problem_with(
+                StatusCode::UNPROCESSABLE_ENTITY,
+                "Invalid case",
+                &detail,
+                json!({ "errors": errors, "warnings": problems_json(&report.warnings) }),
+            );
         }
     };
     match app.store.count(Status::Queued) {
@@ -96,7 +111,13 @@ pub async fn list(State(app): State<Arc<App>>, Query(q): Query<ListQuery>) -> Re
         None | Some("") => None,
         Some(s) => match Status::parse(s) {
             Some(st) => Some(st),
-            None => return problem(StatusCode::BAD_REQUEST, "Bad status filter", "status is one of queued, running, succeeded, failed, cancelled"),
+            None => {
+                return problem(
+                    StatusCode::BAD_REQUEST,
+                    "Bad status filter",
+                    "status is one of queued, running, succeeded, failed, cancelled",
+                )
+            }
         },
     };
     let (limit, offset) = (q.limit.unwrap_or(50).clamp(1, 500), q.offset.unwrap_or(0));
@@ -141,14 +162,19 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
     };
     match job.status {
         Status::Succeeded | Status::Failed => {
-            return problem(StatusCode::CONFLICT, "Job already finished", &format!("the job has {}", job.status.as_str()))
+            return problem(
+                StatusCode::CONFLICT,
+                "Job already finished",
+                &format!("the job has {}", job.status.as_str()),
+            )
         }
         Status::Cancelled => return Json(job.to_json()).into_response(),
         Status::Queued | Status::Running => {}
     }
     cancel_flag(&app, &id).store(true, Ordering::SeqCst);
     if job.status == Status::Queued {
-        if let Ok(true) = app.store.finish(&id, Status::Cancelled, Some("cancelled before it started"), &now_rfc3339()) {
+        if let Ok(true) = app.store.finish(&id, Status::Cancelled, Some("cancelled before it started"), &now_rfc3339())
+        {
             if let Ok(Some(j)) = app.store.get(&id) {
                 app.hub.publish(&id, JobEvent::new("status", None, &j.status_json()));
                 app.hub.publish(&id, JobEvent::new("end", None, &j.status_json()));
@@ -168,13 +194,23 @@ pub struct EventsQuery {
 }
 
 /// Server-sent events; resume with the `Last-Event-ID` header (or `?last_event_id=`).
-pub async fn events(State(app): State<Arc<App>>, Path(id): Path<String>, Query(q): Query<EventsQuery>, headers: HeaderMap) -> Response {
+pub async fn events(
+    State(app): State<Arc<App>>,
+    Path(id): Path<String>,
+    Query(q): Query<EventsQuery>,
+    headers: HeaderMap,
+) -> Response {
     if let Err(r) = find(&app, &id) {
         return r;
     }
-    let last = headers.get("last-event-id").and_then(|v| v.to_str().ok()).and_then(|s| s.trim().parse::<u64>().ok()).or(q.last_event_id);
+    let last = headers
+        .get("last-event-id")
+        .and_then(|v| v.to_str().ok())
+        .and_then(|s| s.trim().parse::<u64>().ok())
+        .or(q.last_event_id);
     let (tx, rx) = tokio::sync::mpsc::channel::<Event>(32);
     tokio::spawn(pump(app.clone(), id, last, tx));
-    let stream = futures_util::stream::unfold(rx, |mut rx| async move { rx.recv().await.map(|e| (Ok::<_, Infallible>(e), rx)) });
+    let stream =
+        futures_util::stream::unfold(rx, |mut rx| async move { rx.recv().await.map(|e| (Ok::<_, Infallible>(e), rx)) });
     Sse::new(stream).keep_alive(KeepAlive::new().interval(Duration::from_secs(15))).into_response()
 }

@@ -95,7 +95,9 @@ fn solid_body_rotation_runs_10000_steps_without_growth() {
         let r = (x * x + y * y).sqrt();
         s.set_cell(c, rho0 * (omega * omega * r * r / (2.0 * a * a)).exp(), [0.0, omega * r, 0.0]);
     }
-    let ke = |s: &GasSolver| (0..n).map(|c| s.density(c) * s.velocity_cyl(c).iter().map(|v| v * v).sum::<f64>()).sum::<f64>();
+    let ke = |s: &GasSolver| {
+        (0..n).map(|c| s.density(c) * s.velocity_cyl(c).iter().map(|v| v * v).sum::<f64>()).sum::<f64>()
+    };
     let ke0 = ke(&s);
     let dt = s.stable_dt();
     let mut ke_max: f64 = 0.0;

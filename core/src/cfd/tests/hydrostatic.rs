@@ -25,9 +25,15 @@ fn quiescent_column_relaxes_to_the_isothermal_hydrostatic_profile() {
     let want_variation = rho(nz - 1) * ((9.81 * (z(nz - 1) - z(0)) / a2).exp() - 1.0);
     for k in 0..nz {
         let want = rho(nz - 1) * (9.81 * (z(nz - 1) - z(k)) / a2).exp();
-        assert!((rho(k) - want).abs() < 0.02 * want_variation, "layer {k}: ρ = {} want {want} (variation {variation:e})", rho(k));
+        assert!(
+            (rho(k) - want).abs() < 0.02 * want_variation,
+            "layer {k}: ρ = {} want {want} (variation {variation:e})",
+            rho(k)
+        );
     }
-    let umax = (0..s.grid().num_cells()).map(|c| s.velocity_cyl(c).iter().fold(0.0f64, |m, v| m.max(v.abs()))).fold(0.0, f64::max);
+    let umax = (0..s.grid().num_cells())
+        .map(|c| s.velocity_cyl(c).iter().fold(0.0f64, |m, v| m.max(v.abs())))
+        .fold(0.0, f64::max);
     // The initial imbalance drives velocities of order (ρgH/a²/ρ)·a ≈ 3e-3 m/s.
     assert!(umax < 1e-5, "velocities have not decayed: {umax:e} m/s");
 }

@@ -28,10 +28,19 @@ struct Zone {
 
 impl Zone {
     fn run(&self) -> GasSolver {
-        let gas = Gas { superficial_velocity_m_s: self.u0, ramp_time_s: 2e-3, inlet_voidage: self.inlet_voidage, viscosity_pa_s: MU, outlet_relaxation: 0.25, ..Default::default() };
+        let gas = Gas {
+            superficial_velocity_m_s: self.u0,
+            ramp_time_s: 2e-3,
+            inlet_voidage: self.inlet_voidage,
+            viscosity_pa_s: MU,
+            outlet_relaxation: 0.25,
+            ..Default::default()
+        };
         let mut s = solver(gas, self.gravity, self.nr, self.dz, self.nz, self.dz);
         let per = s.grid().cells_per_layer();
-        let eps: Vec<f64> = (0..s.grid().num_cells()).map(|c| if (self.k_lo..self.k_hi).contains(&(c / per)) { self.eps } else { 1.0 }).collect();
+        let eps: Vec<f64> = (0..s.grid().num_cells())
+            .map(|c| if (self.k_lo..self.k_hi).contains(&(c / per)) { self.eps } else { 1.0 })
+            .collect();
         s.set_initial_voidage(&eps);
         let dt = s.stable_dt();
         for _ in 0..self.steps {
@@ -72,10 +81,18 @@ impl Zone {
         let (mut inner, mut edge): (f64, f64) = (0.0, 0.0);
         for k in self.k_lo..self.k_hi - 1 {
             let got = (p[k] - p[k + 1]) / self.dz;
-            eprintln!("{label}: layers {k}-{}: {got:.2} Pa/m, analytic {want:.2} Pa/m ({:+.2} %)", k + 1, 100.0 * (got / want - 1.0));
+            eprintln!(
+                "{label}: layers {k}-{}: {got:.2} Pa/m, analytic {want:.2} Pa/m ({:+.2} %)",
+                k + 1,
+                100.0 * (got / want - 1.0)
+            );
             let err = (got / want - 1.0).abs();
             let at_jump = (k == self.k_lo && k > 0) || k + 2 == self.k_hi;
-            if at_jump { edge = edge.max(err) } else { inner = inner.max(err) }
+            if at_jump {
+                edge = edge.max(err)
+            } else {
+                inner = inner.max(err)
+            }
         }
         (inner, edge)
     }
@@ -85,7 +102,18 @@ impl Zone {
 fn every_layer_pair_of_a_dense_zone_gives_the_beetstra_drop() {
     // ε = 0.4 over 16 layers of a 1-annulus column, ε = 1 around it (as porous_zone.rs). Before the
     // face correction the drops alternated +96 % / −89 % of the analytic value.
-    let z = Zone { nr: 1, nz: 40, dz: 0.0025, k_lo: 12, k_hi: 28, eps: 0.4, gravity: 0.0, inlet_voidage: 1.0, u0: 0.2, steps: 12_000 };
+    let z = Zone {
+        nr: 1,
+        nz: 40,
+        dz: 0.0025,
+        k_lo: 12,
+        k_hi: 28,
+        eps: 0.4,
+        gravity: 0.0,
+        inlet_voidage: 1.0,
+        u0: 0.2,
+        steps: 12_000,
+    };
     let (inner, edge) = z.check_every_layer_pair("ε = 0.4 zone");
     assert!(inner < 0.01, "worst layer pair clear of the zone ends off by {:.2} %", 100.0 * inner);
     assert!(edge < 0.05, "worst layer pair at a zone end off by {:.2} %", 100.0 * edge);
@@ -97,7 +125,18 @@ fn every_layer_pair_of_the_lattice_bed_gives_the_beetstra_drop() {
     // its voidage 0.727 uniform in the bed's four layers, gravity on, fed from below at the bed's
     // own voidage (an inlet ε_in = 0.4 adds the jet's momentum flux ρU²(1/ε_in − 1/ε) to layer 0).
     // Before the face correction the drops alternated +69 % / −69 %.
-    let z = Zone { nr: 5, nz: 7, dz: 0.0044, k_lo: 0, k_hi: 4, eps: 0.727, gravity: 9.81, inlet_voidage: 0.727, u0: 0.2, steps: 8_000 };
+    let z = Zone {
+        nr: 5,
+        nz: 7,
+        dz: 0.0044,
+        k_lo: 0,
+        k_hi: 4,
+        eps: 0.727,
+        gravity: 9.81,
+        inlet_voidage: 0.727,
+        u0: 0.2,
+        steps: 8_000,
+    };
     let (inner, edge) = z.check_every_layer_pair("ε = 0.727 bed");
     assert!(inner.max(edge) < 0.03, "worst layer pair off by {:.2} %", 100.0 * inner.max(edge));
 }

@@ -6,7 +6,11 @@ use crate::grid::CylGrid;
 
 /// A case with the given gas section, gravity and a column of radius R and height H.
 pub fn case_with(gas: Gas, gravity: f64, radius: f64, height: f64) -> Case {
-    let json = format!(r#"{{"column":{{"diameter_m":{},"height_m":{}}},"particles":{{}},"bed":{{"generated":{{"settled_height_m":0.002}}}}}}"#, 2.0 * radius, height);
+    let json = format!(
+        r#"{{"column":{{"diameter_m":{},"height_m":{}}},"particles":{{}},"bed":{{"generated":{{"settled_height_m":0.002}}}}}}"#,
+        2.0 * radius,
+        height
+    );
     let mut c: Case = serde_json::from_str(&json).expect("case");
     c.gas = Some(gas);
     c.gravity_m_s2 = gravity;

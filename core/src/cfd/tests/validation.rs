@@ -13,7 +13,8 @@ fn too_large_a_gas_step_is_refused_with_the_limit() {
     // Acoustic bound: AB3's 0.7236 over a'·((1 + n0/π)/dr + 1/dz), a' = a/√(1 − s₀) with the face
     // correction's rate s₀ (stability.rs), times the CFL factor 0.9.
     let a_eff = 290.1 / (1.0 - FACE_FLUX_RATE).sqrt();
-    let acoustic = 0.9 * AB3_IMAGINARY_LIMIT / (a_eff * ((1.0 + 3.0 / std::f64::consts::PI) / 0.0044 + 1.0 / 0.0044444));
+    let acoustic =
+        0.9 * AB3_IMAGINARY_LIMIT / (a_eff * ((1.0 + 3.0 / std::f64::consts::PI) / 0.0044 + 1.0 / 0.0044444));
     assert!(limit < acoustic && limit > 0.95 * acoustic, "limit {limit:e} vs acoustic {acoustic:e}");
     let dem = case.dem.time_step_s;
     let n_ok = (limit / dem).floor();

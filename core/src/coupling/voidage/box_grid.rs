@@ -77,7 +77,16 @@ impl BoxGrid {
         let mut a = 0.0;
         for (i, j) in candidate_cells(grid, x0, x0 + self.dl, y0, y0 + self.dl) {
             let (t0, t1) = grid.theta_bounds(i, j);
-            a += rect_cell_area(x0, x0 + self.dl, y0, y0 + self.dl, i as f64 * grid.dr, (i + 1) as f64 * grid.dr, t0, t1);
+            a += rect_cell_area(
+                x0,
+                x0 + self.dl,
+                y0,
+                y0 + self.dl,
+                i as f64 * grid.dr,
+                (i + 1) as f64 * grid.dr,
+                t0,
+                t1,
+            );
         }
         a
     }
@@ -106,7 +115,8 @@ fn candidate_cells(grid: &CylGrid, x0: f64, x1: f64, y0: f64, y1: f64) -> Vec<(u
         let mut lo: f64 = 0.0;
         let mut hi: f64 = 0.0;
         for (x, y) in [(x0, y0), (x1, y0), (x1, y1), (x0, y1)] {
-            let d = (y.atan2(x) - tc + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+            let d =
+                (y.atan2(x) - tc + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
             lo = lo.min(d);
             hi = hi.max(d);
         }

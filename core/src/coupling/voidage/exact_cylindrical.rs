@@ -63,7 +63,14 @@ fn disk_inside_cell(g: &CylGrid, x: f64, y: f64, rho: f64, i: usize, j: usize) -
     (t0.cos() * y - t0.sin() * x) >= rho && (t1.sin() * x - t1.cos() * y) >= rho
 }
 
-fn split_sphere(g: &CylGrid, nodes: &[(f64, f64)], p: &[f64; 3], a: f64, out: &mut [f64], cells: &mut Vec<(usize, f64)>) {
+fn split_sphere(
+    g: &CylGrid,
+    nodes: &[(f64, f64)],
+    p: &[f64; 3],
+    a: f64,
+    out: &mut [f64],
+    cells: &mut Vec<(usize, f64)>,
+) {
     let vp = 4.0 / 3.0 * PI * a * a * a;
     let (i, j) = g.locate_ij(p[0], p[1]);
     let layers = Axis::new(0.0, g.dz, g.nz);

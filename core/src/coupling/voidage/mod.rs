@@ -8,8 +8,8 @@ pub mod direct;
 pub mod exact_cylindrical;
 pub mod grouping;
 pub mod polar_area;
-pub mod sphere_box;
 pub mod sampling;
+pub mod sphere_box;
 pub mod square_grid;
 pub mod table3;
 

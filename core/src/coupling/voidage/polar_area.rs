@@ -123,9 +123,8 @@ fn disk_sector_area(c: P, rho: f64, s: f64, th0: f64, th1: f64) -> f64 {
             n += 2;
         }
     }
-    let arc_d = |a: f64, b: f64| {
-        0.5 * (rho * rho * (b - a) + rho * (c[0] * (b.sin() - a.sin()) - c[1] * (b.cos() - a.cos())))
-    };
+    let arc_d =
+        |a: f64, b: f64| 0.5 * (rho * rho * (b - a) + rho * (c[0] * (b.sin() - a.sin()) - c[1] * (b.cos() - a.cos())));
     let inside_all_d = |phi: f64| {
         let p = [c[0] + rho * phi.cos(), c[1] + rho * phi.sin()];
         p[0] * p[0] + p[1] * p[1] < s * s && in_wedge(p)
@@ -212,7 +211,8 @@ mod tests {
 
     #[test]
     fn rectangle_area_matches_lattice_sampling() {
-        let cells = [(0.0, 1.0, 0.0, 2.0 * PI / 3.0), (1.0, 2.0, 0.3, 1.1), (2.0, 3.0, 2.0, 2.5), (0.0, 1.0, 4.0, 2.0 * PI)];
+        let cells =
+            [(0.0, 1.0, 0.0, 2.0 * PI / 3.0), (1.0, 2.0, 0.3, 1.1), (2.0, 3.0, 2.0, 2.5), (0.0, 1.0, 4.0, 2.0 * PI)];
         let rects = [(-0.5, 0.7, -0.2, 0.9), (0.5, 1.9, 0.1, 1.6), (-2.9, -1.0, 1.5, 2.7), (0.1, 0.9, -0.9, 0.2)];
         for cell in cells {
             for r in rects {

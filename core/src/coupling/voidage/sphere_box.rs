@@ -15,8 +15,7 @@ fn u(p: f64, q: f64, s: f64) -> f64 {
     if p * p + q * q + s * s >= 1.0 {
         return 0.0;
     }
-    PI / 12.0 * (2.0 - 3.0 * (p + q + s) + p * p * p + q * q * q + s * s * s) + w(p, q) + w(q, s) + w(p, s)
-        - p * q * s
+    PI / 12.0 * (2.0 - 3.0 * (p + q + s) + p * p * p + q * q * q + s * s * s) + w(p, q) + w(q, s) + w(p, s) - p * q * s
 }
 
 /// Unit-sphere volume beyond one plane x > p, any sign of p.

@@ -61,7 +61,15 @@ impl VoidageMethod for SquareGrid {
 /// The paper's two stages (eq. 8): every particle's cube onto the boxes (≤ 8 boxes per particle,
 /// PHYSICS.md 4), then each box's solid volume onto the cells with the precomputed fractions,
 /// once per call — so the per-particle work does not grow with the cells a box touches.
-fn two_stage_cuboid(g: &CylGrid, bg: &BoxGrid, bufs: &mut Vec<Vec<f64>>, positions: &[[f64; 3]], radius: f64, h: f64, out: &mut [f64]) {
+fn two_stage_cuboid(
+    g: &CylGrid,
+    bg: &BoxGrid,
+    bufs: &mut Vec<Vec<f64>>,
+    positions: &[[f64; 3]],
+    radius: f64,
+    h: f64,
+    out: &mut [f64],
+) {
     use rayon::prelude::*;
     let nb = bg.nb;
     let nboxes = nb * nb * g.nz;

@@ -7,7 +7,8 @@ use rand::{Rng, SeedableRng};
 use std::f64::consts::PI;
 
 fn all_methods(g: &CylGrid) -> Vec<Box<dyn VoidageMethod>> {
-    let mut v: Vec<Box<dyn VoidageMethod>> = vec![Box::new(Direct::new(g)), Box::new(Grouping::new(g)), Box::new(ExactCylindrical::new(g))];
+    let mut v: Vec<Box<dyn VoidageMethod>> =
+        vec![Box::new(Direct::new(g)), Box::new(Grouping::new(g)), Box::new(ExactCylindrical::new(g))];
     for dl in table3::BOX_SIDES {
         v.push(Box::new(SquareGrid::new(g, dl, BoxSplit::Cuboid, 1.0)));
         v.push(Box::new(SquareGrid::new(g, dl, BoxSplit::Exact, 1.0)));
@@ -28,7 +29,11 @@ fn random_bed(g: &CylGrid, n: usize, a: f64, seed: u64) -> Vec<[f64; 3]> {
         .collect();
     p.push([0.0, 0.0, a]);
     p.push([g.radius - a, 0.0, g.height - a]);
-    p.push([(g.radius - a) * std::f64::consts::FRAC_1_SQRT_2, (g.radius - a) * std::f64::consts::FRAC_1_SQRT_2, 2.0 * g.dz]);
+    p.push([
+        (g.radius - a) * std::f64::consts::FRAC_1_SQRT_2,
+        (g.radius - a) * std::f64::consts::FRAC_1_SQRT_2,
+        2.0 * g.dz,
+    ]);
     p
 }
 
@@ -94,11 +99,17 @@ fn table3_square_grid_keeps_layers_and_finer_boxes_are_nearer_exact() {
     let vs = table3::COUNT as f64 * PI * table3::DIAMETER.powi(3) / 6.0;
     let exact = 1.0 - vs / t.g.cell_volume();
     for split in [BoxSplit::Cuboid, BoxSplit::Exact] {
-        let e: Vec<Vec<f64>> = table3::BOX_SIDES.iter().map(|&dl| voidage_of(&t, &mut SquareGrid::new(&t.g, dl, split, 1.0))).collect();
+        let e: Vec<Vec<f64>> =
+            table3::BOX_SIDES.iter().map(|&dl| voidage_of(&t, &mut SquareGrid::new(&t.g, dl, split, 1.0))).collect();
         for ec in &e {
             assert_eq!((ec[7], ec[8]), (1.0, 1.0), "{split:?}: cells below/above");
         }
-        assert!((e[2][0] - exact).abs() < (e[0][0] - exact).abs(), "{split:?}: config 3 {} config 1 {} exact {exact}", e[2][0], e[0][0]);
+        assert!(
+            (e[2][0] - exact).abs() < (e[0][0] - exact).abs(),
+            "{split:?}: config 3 {} config 1 {} exact {exact}",
+            e[2][0],
+            e[0][0]
+        );
     }
     // the exact-cylindrical method is exact here
     let e = voidage_of(&t, &mut ExactCylindrical::new(&t.g));

@@ -57,7 +57,10 @@ fn batch_against_scalar_law(n: usize) {
     let mut batch = filled();
     let mut vector = None;
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") && std::arch::is_x86_feature_detected!("bmi2") {
+    if std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("bmi2")
+    {
         let mut b2 = filled();
         let mut shear = shear0.clone();
         let maxima = b2.evaluate::<true, true>(&p.pair, true, r, p.dt, &v, &w, &mut shear, 0);

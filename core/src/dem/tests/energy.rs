@@ -11,7 +11,11 @@ pub fn random_gas(n: usize, rt: f64, h: f64, r: f64, speed: f64, seed: u64) -> (
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
     let mut x: Vec<[f64; 3]> = Vec::new();
     while x.len() < n {
-        let p = [(rng.gen::<f64>() * 2.0 - 1.0) * rt, (rng.gen::<f64>() * 2.0 - 1.0) * rt, r + rng.gen::<f64>() * (h - 2.0 * r)];
+        let p = [
+            (rng.gen::<f64>() * 2.0 - 1.0) * rt,
+            (rng.gen::<f64>() * 2.0 - 1.0) * rt,
+            r + rng.gen::<f64>() * (h - 2.0 * r),
+        ];
         let inside = (p[0] * p[0] + p[1] * p[1]).sqrt() < rt - 1.05 * r;
         if inside && x.iter().all(|q| (0..3).map(|k| (q[k] - p[k]).powi(2)).sum::<f64>() > 4.4 * r * r) {
             x.push(p);

@@ -5,9 +5,9 @@
 use super::energy::random_gas;
 use super::{test_case, with_damping};
 use crate::dem::forces::{pair_pass, Kernels, Scratch};
+use crate::dem::near_list::{Histories, NearList};
 use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemSystem;
-use crate::dem::near_list::{Histories, NearList};
 use std::collections::{HashMap, HashSet};
 
 /// Pairs (i < j) listed in the near list now.
@@ -44,7 +44,11 @@ fn near_list_holds_every_touching_pair() {
                 let r2: f64 = (0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum();
                 if r2 < d * d {
                     touching_seen += 1;
-                    assert!(listed.contains(&(i as u32, j as u32)), "touching pair ({i}, {j}) missing at step {}", s.steps());
+                    assert!(
+                        listed.contains(&(i as u32, j as u32)),
+                        "touching pair ({i}, {j}) missing at step {}",
+                        s.steps()
+                    );
                 }
             }
         }
@@ -125,7 +129,10 @@ fn near_list_pair_pass_equals_the_whole_lists() {
         let o = old[&k];
         assert_eq!(again.list.nbr[e], s.near.list.nbr[o]);
         assert_eq!(again.list.touch[e], s.near.list.touch[o]);
-        assert!(again.list.shear[e].map(f32::to_bits) == s.near.list.shear[o].map(f32::to_bits), "history of entry {k}");
+        assert!(
+            again.list.shear[e].map(f32::to_bits) == s.near.list.shear[o].map(f32::to_bits),
+            "history of entry {k}"
+        );
         live += again.list.touch[e] as usize;
     }
     assert_eq!(live, s.near.list.touch.iter().filter(|&&t| t == 1).count(), "a live history was dropped");

@@ -12,7 +12,8 @@ use rand::{Rng, SeedableRng};
 fn scatter_random(run: impl Fn(&Batch, &mut [PairSum])) -> (Vec<PairSum>, Vec<[f64; 6]>, Vec<[f64; 6]>, Vec<usize>) {
     let n = 40;
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
-    let (mut acc, mut exact, mut abs, mut terms) = (vec![PairSum::default(); n], vec![[0.0; 6]; n], vec![[0.0; 6]; n], vec![0; n]);
+    let (mut acc, mut exact, mut abs, mut terms) =
+        (vec![PairSum::default(); n], vec![[0.0; 6]; n], vec![[0.0; 6]; n], vec![0; n]);
     let mut b = Batch::new();
     for m in (1..=CAP).chain(1..=CAP) {
         for l in 0..m {
@@ -68,8 +69,10 @@ fn vector_scatter_equals_the_portable_one() {
         let portable = scatter_random(|b, acc| scatter::<true, false>(b, acc)).0;
         let vector = scatter_random(|b, acc| scatter::<true, true>(b, acc)).0;
         assert!(bits(&portable) == bits(&vector), "vector and portable scatter differ");
-        let (portable, vector) =
-            (scatter_random(|b, acc| scatter::<false, false>(b, acc)).0, scatter_random(|b, acc| scatter::<false, true>(b, acc)).0);
+        let (portable, vector) = (
+            scatter_random(|b, acc| scatter::<false, false>(b, acc)).0,
+            scatter_random(|b, acc| scatter::<false, true>(b, acc)).0,
+        );
         assert!(bits(&portable) == bits(&vector), "vector and portable scatter differ without friction");
         assert!(portable.iter().all(|r| r.0[3..] == [0.0; 5]), "no torque sums without friction");
     }

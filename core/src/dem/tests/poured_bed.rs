@@ -66,13 +66,19 @@ fn poured_bed_stays_in_the_column_and_packs_randomly() {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
     let (x, _) = pool
         .install(|| {
-            generate(&case, Some(2500), None, 5, Some(&mut |s: &DemSystem| {
-                for p in s.positions() {
-                    let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
-                    worst_wall = worst_wall.max(rho - rt).max(-p[2]);
-                }
-                worst_coulomb = worst_coulomb.max(s.max_coulomb_excess());
-            }))
+            generate(
+                &case,
+                Some(2500),
+                None,
+                5,
+                Some(&mut |s: &DemSystem| {
+                    for p in s.positions() {
+                        let rho = (p[0] * p[0] + p[1] * p[1]).sqrt();
+                        worst_wall = worst_wall.max(rho - rt).max(-p[2]);
+                    }
+                    worst_coulomb = worst_coulomb.max(s.max_coulomb_excess());
+                }),
+            )
         })
         .unwrap();
     assert_eq!(x.len(), 2500);
@@ -91,7 +97,8 @@ fn poured_bed_stays_in_the_column_and_packs_randomly() {
 fn generated_bed_is_cached_and_reproducible() {
     let mut case = test_case(0.0096, 0.05, false, 9.81, 4e-6);
     case.particles.youngs_modulus_pa = 1.2e7;
-    case.bed = crate::case::Bed::Generated(crate::case::GeneratedBed { settled_height_m: None, count: Some(150), seed: 9 });
+    case.bed =
+        crate::case::Bed::Generated(crate::case::GeneratedBed { settled_height_m: None, count: Some(150), seed: 9 });
     let dir = std::env::temp_dir().join(format!("fluidbed-bed-cache-{}", std::process::id()));
     let a = build_bed(&case, Some(&dir)).unwrap();
     assert!(dir.join(format!("bed-{:016x}.bin", cache_key(&case))).exists());

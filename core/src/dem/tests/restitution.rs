@@ -22,7 +22,10 @@ fn measured_e(alpha: f64, v0: f64, wall: bool, no_tension: bool) -> f64 {
     let (x, v) = if wall {
         (vec![[0.0, 0.0, r + gap]], vec![[0.0, 0.0, -v0]])
     } else {
-        (vec![[-r - gap / 2.0, 0.0, 0.01], [r + gap / 2.0, 0.0, 0.01]], vec![[v0 / 2.0, 0.0, 0.0], [-v0 / 2.0, 0.0, 0.0]])
+        (
+            vec![[-r - gap / 2.0, 0.0, 0.01], [r + gap / 2.0, 0.0, 0.01]],
+            vec![[v0 / 2.0, 0.0, 0.0], [-v0 / 2.0, 0.0, 0.0]],
+        )
     };
     let mut sys = DemSystem::with_params(p, x, v);
     let mut apart_for = 0;

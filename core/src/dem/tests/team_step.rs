@@ -57,7 +57,8 @@ fn team_step_equals_the_plain_passes() {
 
 #[test]
 fn systems_stepped_in_a_parallel_loop_match_one_stepped_alone() {
-    let (nested, alone): (Vec<DemSystem>, DemSystem) = pool().install(|| ((0..2).into_par_iter().map(|_| run_busy()).collect(), run_busy()));
+    let (nested, alone): (Vec<DemSystem>, DemSystem) =
+        pool().install(|| ((0..2).into_par_iter().map(|_| run_busy()).collect(), run_busy()));
     assert!(nested.iter().all(|s| same_state(s, &alone)));
 }
 
