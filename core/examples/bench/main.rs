@@ -1,7 +1,8 @@
-//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|all>`.
+//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
 mod cfd;
+mod coupled;
 mod dem;
 mod voidage;
 
@@ -9,10 +10,11 @@ fn main() {
     let what = std::env::args().nth(1).unwrap_or_else(|| "all".into());
     match what.as_str() {
         "cfd" => cfd::run(),
+        "coupled" => coupled::run(),
         "dem" => dem::run(),
         "voidage" => voidage::run(),
         other => {
-            eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage or all");
+            eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage, coupled");
             std::process::exit(2);
         }
     }

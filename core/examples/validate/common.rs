@@ -114,7 +114,7 @@ pub fn timed_case(path: &str) -> serde_json::Value {
     let (sim, snaps) = run_case(case, path);
     let t = sim.timers();
     serde_json::json!({"name": "case", "case": path, "particles": sim.dem().len(), "steps": sim.steps(), "snapshots": snaps.len(),
-        "wall_s": t0.elapsed().as_secs_f64(), "dem_s": t.dem, "gas_s": t.gas, "voidage_s": t.voidage, "exchange_s": t.exchange,
+        "wall_s": t0.elapsed().as_secs_f64(), "dem_s": t.dem(), "neighbours_s": t.neighbours, "output_s": t.output, "gas_s": t.gas, "voidage_s": t.voidage, "exchange_s": t.exchange,
         "last_dp_pa": snaps.last().and_then(|s| s.pressure_drop_pa),
         "last_layer_pressure_pa": snaps.last().and_then(|s| s.pressure_pa.as_ref().map(|p| layers(s, p)))})
 }

@@ -38,6 +38,32 @@ pub struct Case {
     /// How particle volume becomes cell voidage.
     #[serde(default)]
     pub voidage: Voidage,
+    /// The particle–gas exchange: drag law and how often voidage and drag are recomputed.
+    #[serde(default)]
+    pub coupling: Coupling,
+}
+
+/// The particle–gas exchange (paper section 2.3).
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct Coupling {
+    /// Drag law (PHYSICS.md 1): "beetstra" (the paper's), "gidaspow" (Ergun + Wen–Yu), "di_felice".
+    pub drag_law: crate::coupling::DragModel,
+    /// DEM steps between recomputations of voidage and drag (1 = every step, the paper's); the
+    /// drag on each particle and on the gas is held in between, the gas still steps at its own
+    /// stable step. Default from the run-time/error trade-off (docs/BENCHMARKS.md).
+    #[serde(default = "d_coupling_interval")]
+    pub interval_steps: u32,
+}
+
+impl Default for Coupling {
+    fn default() -> Self {
+        Coupling { drag_law: Default::default(), interval_steps: d_coupling_interval() }
+    }
+}
+
+fn d_coupling_interval() -> u32 {
+    10
 }
 
 /// The cylindrical column (tube). Its axis is the z axis, the distributor plate is z = 0.

@@ -205,6 +205,10 @@ impl Case {
         if let Some(g) = &self.gas {
             self.validate_gas(g, &mut r);
         }
+        let n = self.coupling.interval_steps;
+        if !(1..=1000).contains(&n) {
+            r.error("/coupling/interval_steps", n, "[1, 1000]", "DEM steps between couplings out of range");
+        }
         r
     }
 
@@ -461,4 +465,5 @@ struct PartialCase {
     gas: Option<Option<Gas>>,
     grid: Option<Grid>,
     voidage: Option<Voidage>,
+    coupling: Option<super::Coupling>,
 }

@@ -24,6 +24,8 @@ pub struct HFace {
     pub s_abs: f64,
     pub dx: f64,
     pub dy: f64,
+    /// |d|, the distance between the two centres.
+    pub delta: f64,
 }
 
 /// Horizontal neighbour of an in-layer cell with the outward vector area of the shared face.
@@ -90,6 +92,7 @@ impl FaceGeometry {
                     s_abs: area,
                     dx,
                     dy,
+                    delta: dx.hypot(dy),
                 });
                 // Radial segments shared with the outer annulus.
                 if i + 1 < g.nr {
@@ -112,6 +115,7 @@ impl FaceGeometry {
                             s_abs: sx.hypot(sy),
                             dx,
                             dy,
+                            delta: dx.hypot(dy),
                         });
                     }
                 }

@@ -264,21 +264,39 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: us
     (conv, visc, dff)
 }
 
-/// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
-/// layer's face corrections: the axial faces above its cells into `out_fz` (one layer long, zero
-/// for the top layer), its horizontal faces into `out_fh`.
-pub fn residual_layer(
+/// The axial faces above the cells of layer k (k + 1 < nz), computed once for both layers they
+/// join: per face [ṁ, ṁu_x, ṁu_y, ṁu_z, viscous force on the lower cell (3)] into `out` and dF/dt
+/// into `out_fz` (one layer long).
+pub fn axial_layer(
     inp: &RhsInput,
     q: &[[f64; 4]],
     pr: &Primitives,
     k: usize,
-    out: &mut [[f64; 4]],
+    out: &mut [[f64; 7]],
     out_fz: &mut [f64],
+) {
+    let base = k * inp.per;
+    for c in 0..inp.per {
+        let (conv, visc, dff) = axial_face(inp, q, pr, k, base + c);
+        out[c] = [conv[0], conv[1], conv[2], conv[3], visc[0], visc[1], visc[2]];
+        out_fz[c] = dff;
+    }
+}
+
+/// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
+/// layer's horizontal face corrections into `out_fh`; `axial` holds the axial faces of
+/// `axial_layer` (the one below layer k at index k − 1, the one above at k).
+pub fn residual_layer(
+    inp: &RhsInput,
+    q: &[[f64; 4]],
+    pr: &Primitives,
+    axial: &[[f64; 7]],
+    k: usize,
+    out: &mut [[f64; 4]],
     out_fh: &mut [f64],
 ) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let base = k * per;
-    out_fz.iter_mut().for_each(|r| *r = 0.0);
     if k + 1 == inp.nz && par.outlet == Outlet::Characteristic && inp.nz > 1 {
         // The outlet layer follows eq. (5)–(7) instead of the fluxes (solver.rs).
         out.iter_mut().for_each(|r| *r = [0.0; 4]);
@@ -307,15 +325,8 @@ pub fn residual_layer(
         let diss = kappa_a * eps_f * f.s_abs * mismatch;
         let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) + ff_h[n] * f.s_abs - diss;
         let rho_f = 0.5 * (pr.p[a] + pr.p[b]) / a2;
-        out_fh[n] = face_flux_rate(
-            eps_f,
-            rho_f,
-            0.5 * (pr.beta[a] + pr.beta[b]),
-            mismatch,
-            f.dx.hypot(f.dy),
-            ff_h[n],
-            par.sound_speed,
-        );
+        out_fh[n] =
+            face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[a] + pr.beta[b]), mismatch, f.delta, ff_h[n], par.sound_speed);
         let h = 0.5 * mflux * inv_v;
         let conv = [mflux * inv_v, h * (pr.ux[a] + pr.ux[b]), h * (pr.uy[a] + pr.uy[b]), h * (pr.uz[a] + pr.uz[b])];
         let m = par.viscosity * f.area_over_delta * inv_v;
@@ -348,22 +359,21 @@ pub fn residual_layer(
             r[0] += m_in * inv_v;
             r[3] += m_in * w_in * inv_v;
         } else {
-            let (conv, visc, _) = axial_face(inp, q, pr, k - 1, i - per);
+            let f = &axial[i - per];
             for n in 0..4 {
-                r[n] += conv[n] * inv_v;
+                r[n] += f[n] * inv_v;
             }
             for n in 0..3 {
-                r[n + 1] -= e * visc[n];
+                r[n + 1] -= e * f[n + 4];
             }
         }
         if k + 1 < inp.nz {
-            let (conv, visc, dff) = axial_face(inp, q, pr, k, i);
-            out_fz[c] = dff;
+            let f = &axial[i];
             for n in 0..4 {
-                r[n] -= conv[n] * inv_v;
+                r[n] -= f[n] * inv_v;
             }
             for n in 0..3 {
-                r[n + 1] += e * visc[n];
+                r[n + 1] += e * f[n + 4];
             }
         }
     }

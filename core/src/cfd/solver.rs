@@ -5,7 +5,8 @@ use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::outlet_density_change;
 use super::geometry::FaceGeometry;
 use super::rhs::{
-    gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives, RhsInput,
+    axial_layer, gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives,
+    RhsInput,
 };
 use super::stability::cell_stable_dt;
 use crate::case::Case;
@@ -84,12 +85,13 @@ pub struct GasSolver {
     stage: Vec<[f64; 4]>,
     face_old: Vec<f64>,
     face_stage: Vec<f64>,
+    /// Axial-face fluxes of the current right-hand side (rhs.rs `axial_layer`).
+    axial: Vec<[f64; 7]>,
     parallel: bool,
 }
 
-/// Below this many cells the layers are processed on one thread (rayon's overhead dominates; see
-/// docs/BENCHMARKS.md "Gas solver").
-const PARALLEL_MIN_CELLS: usize = 20_000;
+/// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
+const PARALLEL_MIN_CELLS: usize = 1_000;
 
 impl GasSolver {
     /// Gas at rest, hydrostatic about `outlet_pressure_pa` at z = height, ε = 1 until set.
@@ -148,6 +150,7 @@ impl GasSolver {
             q_old: vec![[0.0; 4]; n],
             stage: vec![[0.0; 4]; n],
             face_old: vec![0.0; nf],
+            axial: vec![[0.0; 7]; n],
             face_stage: vec![0.0; nf],
             parallel: n >= PARALLEL_MIN_CELLS,
             grid,
@@ -321,6 +324,16 @@ impl GasSolver {
     /// NaN/Inf or non-positive density anywhere, with the cell (i, j, k) and the quantity.
     pub fn check_finite(&self) -> Result<(), String> {
         const NAMES: [&str; 4] = ["ρε", "ρεu_x", "ρεu_y", "ρεu_z"];
+        // One cheap pass (any NaN makes the sum NaN; min of ρε and ε), the details only on failure.
+        let (mut sum, mut min_rho, mut min_eps) = (0.0, f64::INFINITY, f64::INFINITY);
+        for (s, &e) in self.st.q.iter().zip(&self.st.eps) {
+            sum += s[0] + s[1] + s[2] + s[3] + e;
+            min_rho = min_rho.min(s[0]);
+            min_eps = min_eps.min(e);
+        }
+        if sum.is_finite() && min_rho > 0.0 && min_eps > 0.0 {
+            return Ok(());
+        }
         for (c, s) in self.st.q.iter().enumerate() {
             let (i, j, k) = self.grid.ijk(c);
             for (n, v) in s.iter().enumerate() {
@@ -343,6 +356,25 @@ impl GasSolver {
             }
         }
         Ok(())
+    }
+
+    /// What the particle–gas exchange reads per cell, for all cells at once (parallel over
+    /// layers): interstitial velocity (U_r, U_θ, U_z), density ρ and ∇p as `pressure_gradient_cyl`.
+    pub fn exchange_fields(&self, velocity_cyl: &mut [[f64; 3]], density: &mut [f64], grad_p_cyl: &mut [[f64; 3]]) {
+        let per = self.grid.cells_per_layer();
+        let rows = (self.grid.nz / rayon::current_num_threads().max(1)).max(1);
+        (velocity_cyl.par_chunks_mut(per), density.par_chunks_mut(per), grad_p_cyl.par_chunks_mut(per))
+            .into_par_iter()
+            .with_min_len(rows)
+            .enumerate()
+            .for_each(|(k, (v, r, g))| {
+                for c in 0..per {
+                    let cell = k * per + c;
+                    v[c] = self.velocity_cyl(cell);
+                    r[c] = self.density(cell);
+                    g[c] = self.pressure_gradient_cyl(cell);
+                }
+            });
     }
 
     /// Advance by dt: Heun for the first step, then AB2, then AB3 with variable-step weights.
@@ -445,15 +477,17 @@ impl GasSolver {
     }
 
     /// Right-hand sides of the current state (`self.st.q` into `out`, the face corrections into
-    /// `out_face`) at time t.
+    /// `out_face`) at time t: four passes over the layers (primitives, gradients, axial faces,
+    /// residuals), each parallel over blocks of whole layers, so the bits do not depend on threads.
     fn rhs_into(&mut self, t: f64, out: &mut [[f64; 4]], out_face: &mut [f64]) {
         let per = self.grid.cells_per_layer();
+        let nz = self.grid.nz;
         let nf = self.geo.faces.len().max(1);
         let inp = RhsInput {
             geo: &self.geo,
             params: &self.st.params,
             per,
-            nz: self.grid.nz,
+            nz,
             dz: self.grid.dz,
             eps: &self.st.eps,
             force: &self.st.force,
@@ -462,62 +496,48 @@ impl GasSolver {
         };
         let q = &self.st.q;
         let pr = &mut self.prim;
+        // Layers per task: all of them on one thread below the parallel size, else one block per thread.
+        let rows = if self.parallel { nz.div_ceil(rayon::current_num_threads().max(1)) } else { nz };
+        (
+            pr.ux.par_chunks_mut(per),
+            pr.uy.par_chunks_mut(per),
+            pr.uz.par_chunks_mut(per),
+            pr.p.par_chunks_mut(per),
+            pr.beta.par_chunks_mut(per),
+        )
+            .into_par_iter()
+            .with_min_len(rows)
+            .enumerate()
+            .for_each(|(k, (ux, uy, uz, p, b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
+        let (mut div, mut gx, mut gy, mut gz) = (
+            std::mem::take(&mut pr.div),
+            std::mem::take(&mut pr.gx),
+            std::mem::take(&mut pr.gy),
+            std::mem::take(&mut pr.gz),
+        );
+        let prr = &*pr;
+        (div.par_chunks_mut(per), gx.par_chunks_mut(per), gy.par_chunks_mut(per), gz.par_chunks_mut(per))
+            .into_par_iter()
+            .with_min_len(rows)
+            .enumerate()
+            .for_each(|(k, (d, x, y, z))| gradients_layer(&inp, prr, k, d, x, y, z));
+        (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
+        let pr = &*pr;
         let (out_fz, out_fh) = out_face.split_at_mut(q.len());
-        if self.parallel {
-            let beta = &mut pr.beta;
-            pr.ux
-                .par_chunks_mut(per)
-                .zip(pr.uy.par_chunks_mut(per))
-                .zip(pr.uz.par_chunks_mut(per).zip(pr.p.par_chunks_mut(per)))
-                .zip(beta.par_chunks_mut(per))
-                .enumerate()
-                .for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
-            let (mut div, mut gx, mut gy, mut gz) = (
-                std::mem::take(&mut pr.div),
-                std::mem::take(&mut pr.gx),
-                std::mem::take(&mut pr.gy),
-                std::mem::take(&mut pr.gz),
-            );
-            let prr = &*pr;
-            div.par_chunks_mut(per)
-                .zip(gx.par_chunks_mut(per))
-                .zip(gy.par_chunks_mut(per).zip(gz.par_chunks_mut(per)))
-                .enumerate()
-                .for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
-            (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
-            let pr = &*pr;
-            out.par_chunks_mut(per)
-                .zip(out_fz.par_chunks_mut(per).zip(out_fh.par_chunks_mut(nf)))
-                .enumerate()
-                .for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
-        } else {
-            let beta = &mut pr.beta;
-            pr.ux
-                .chunks_mut(per)
-                .zip(pr.uy.chunks_mut(per))
-                .zip(pr.uz.chunks_mut(per).zip(pr.p.chunks_mut(per)))
-                .zip(beta.chunks_mut(per))
-                .enumerate()
-                .for_each(|(k, (((ux, uy), (uz, p)), b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
-            let (mut div, mut gx, mut gy, mut gz) = (
-                std::mem::take(&mut pr.div),
-                std::mem::take(&mut pr.gx),
-                std::mem::take(&mut pr.gy),
-                std::mem::take(&mut pr.gz),
-            );
-            let prr = &*pr;
-            div.chunks_mut(per)
-                .zip(gx.chunks_mut(per))
-                .zip(gy.chunks_mut(per).zip(gz.chunks_mut(per)))
-                .enumerate()
-                .for_each(|(k, ((d, x), (y, z)))| gradients_layer(&inp, prr, k, d, x, y, z));
-            (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
-            let pr = &*pr;
-            out.chunks_mut(per)
-                .zip(out_fz.chunks_mut(per).zip(out_fh.chunks_mut(nf)))
-                .enumerate()
-                .for_each(|(k, (o, (fz, fh)))| residual_layer(&inp, q, pr, k, o, fz, fh));
-        }
+        out_fz[(nz - 1) * per..].fill(0.0);
+        let axial = &mut self.axial;
+        (axial.par_chunks_mut(per), out_fz.par_chunks_mut(per))
+            .into_par_iter()
+            .with_min_len(rows)
+            .take(nz - 1)
+            .enumerate()
+            .for_each(|(k, (a, fz))| axial_layer(&inp, q, pr, k, a, fz));
+        let axial = &*axial;
+        (out.par_chunks_mut(per), out_fh.par_chunks_mut(nf))
+            .into_par_iter()
+            .with_min_len(rows)
+            .enumerate()
+            .for_each(|(k, (o, fh))| residual_layer(&inp, q, pr, axial, k, o, fh));
     }
 }
 

@@ -2,8 +2,9 @@
 
 pub mod drag;
 pub mod exchange;
+pub mod fast_math;
 pub mod voidage;
 
-pub use drag::{beetstra_f, beta_a, drag_force};
-pub use exchange::{Exchange, GasAtCells};
+pub use drag::{beetstra_f, beta_a, drag_force, DragLaw, DragModel};
+pub use exchange::{Exchange, ExchangeParams, GasAtCells};
 pub use voidage::{build_voidage, voidage_from_solid, VoidageMethod};

@@ -64,6 +64,8 @@ pub struct DemSystem {
     spare: (NearList, Vec<u32>),
     #[serde(skip)]
     sc_threads: usize,
+    #[serde(skip)]
+    neighbour_s: f64,
     /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
     #[serde(skip)]
     sc: Scratch,
@@ -104,6 +106,7 @@ impl DemSystem {
             last_move: 0.0,
             spare: Default::default(),
             sc_threads: 0,
+            neighbour_s: 0.0,
             sc: Scratch::default(),
         };
         s.rebuild();
@@ -122,6 +125,15 @@ impl DemSystem {
             self.ext = vec![[0.0; 3]; self.x.len()];
         }
         &mut self.ext
+    }
+    /// Positions and velocities with the external forces to be written, all in the current order.
+    pub fn coupling_views(&mut self) -> (&[[f64; 3]], &[[f64; 3]], &mut [[f64; 3]]) {
+        self.external_forces_mut();
+        (&self.x, &self.v, &mut self.ext)
+    }
+    /// Wall time spent on near-list refreshes and Verlet-list rebuilds since creation (timers).
+    pub fn neighbour_seconds(&self) -> f64 {
+        self.neighbour_s
     }
     pub fn positions(&self) -> &[[f64; 3]] {
         &self.x
@@ -339,11 +351,15 @@ impl DemSystem {
             // The computed distance is within a few ε of the true one.
             self.moved_bound = disp2.sqrt() * (1.0 + 1e-12);
         }
-        if disp2 > refresh_disp2 {
-            self.refresh();
-        }
-        if self.rebuild_due {
-            self.rebuild();
+        if disp2 > refresh_disp2 || self.rebuild_due {
+            let t0 = std::time::Instant::now();
+            if disp2 > refresh_disp2 {
+                self.refresh();
+            }
+            if self.rebuild_due {
+                self.rebuild();
+            }
+            self.neighbour_s += t0.elapsed().as_secs_f64();
         }
     }
 

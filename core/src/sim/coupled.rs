@@ -1,10 +1,10 @@
 //! The coupled step (paper section 2.3): voidage from the particles, drag and −V∇p on the
-//! particles, the opposite drag on the gas in the cell of each particle's centre; the gas is
-//! sub-cycled at its own stable step and the particles at the DEM step, both by AB3, with the
-//! exchange terms held for one gas step.
+//! particles, the opposite drag on the gas in the cell of each particle's centre, recomputed every
+//! `coupling.interval_steps` DEM steps and held in between; the gas steps at its own stable step
+//! and the particles at the DEM step, both by AB3.
 
 use super::{watchdog, SimError, Simulation};
-use crate::coupling::{voidage_from_solid, Exchange, GasAtCells, VoidageMethod};
+use crate::coupling::{voidage_from_solid, Exchange, ExchangeParams, GasAtCells, VoidageMethod};
 use crate::dem::DemSystem;
 use crate::grid::CylGrid;
 
@@ -16,7 +16,6 @@ pub(super) struct Buffers {
     pub cell_density: Vec<f64>,
     pub cell_grad_p: Vec<[f64; 3]>,
     pub cell_force: Vec<[f64; 3]>,
-    pub particle_force: Vec<[f64; 3]>,
     pub exchange: Exchange,
     /// The voidage of a frozen bed is computed once.
     pub voidage_fresh: bool,
@@ -32,7 +31,6 @@ impl Buffers {
             cell_density: vec![0.0; cells],
             cell_grad_p: vec![[0.0; 3]; cells],
             cell_force: vec![[0.0; 3]; cells],
-            particle_force: vec![[0.0; 3]; particles],
             exchange: Exchange::new(grid, particles),
             voidage_fresh: false,
         }
@@ -72,11 +70,7 @@ impl Simulation {
         }
         let t1 = std::time::Instant::now();
         let b = &mut self.buf;
-        for c in 0..self.grid.num_cells() {
-            b.cell_velocity[c] = gas.velocity_cyl(c);
-            b.cell_density[c] = gas.density(c);
-            b.cell_grad_p[c] = gas.pressure_gradient_cyl(c);
-        }
+        gas.exchange_fields(&mut b.cell_velocity, &mut b.cell_density, &mut b.cell_grad_p);
         let g = self.st.case.gas.as_ref().expect("gas section");
         let at = GasAtCells {
             velocity_cyl: &b.cell_velocity,
@@ -84,49 +78,58 @@ impl Simulation {
             grad_p_cyl: &b.cell_grad_p,
             voidage: &b.voidage,
         };
-        let dem = &self.st.dem;
-        let d = 2.0 * dem.radius();
+        let dem = &mut self.st.dem;
+        let par = ExchangeParams {
+            law: self.st.case.coupling.drag_law,
+            mu: g.viscosity_pa_s,
+            eps_min: g.drag_voidage_min,
+            d: 2.0 * dem.radius(),
+        };
         if moving {
-            b.exchange.particle_gas_forces(
-                &self.grid,
-                &at,
-                g.viscosity_pa_s,
-                g.drag_voidage_min,
-                d,
-                dem.positions(),
-                dem.velocities(),
-                &mut b.particle_force,
-                &mut b.cell_force,
-            );
-            self.st.dem.external_forces_mut().copy_from_slice(&b.particle_force);
+            let (pos, vel, ext) = dem.coupling_views();
+            b.exchange.particle_gas_forces(&self.grid, &at, par, (pos, vel), ext, &mut b.cell_force);
         } else {
-            b.exchange.frozen_cell_forces(&self.grid, &at, g.viscosity_pa_s, g.drag_voidage_min, d, &mut b.cell_force);
+            b.exchange.frozen_cell_forces(&self.grid, &at, par, &mut b.cell_force);
         }
         gas.interaction_force_mut().copy_from_slice(&b.cell_force);
         self.timers.voidage += (t1 - t0).as_secs_f64();
         self.timers.exchange += t1.elapsed().as_secs_f64();
     }
 
-    /// One DEM step, with a gas step (or several gas sub-steps) when one is due.
+    /// One DEM step. Every `coupling_interval` DEM steps the voidage and the drag are recomputed
+    /// (held in between); the gas steps at its own step `gas_dt` whenever the DEM step would pass
+    /// the gas time, so the gas leads the particles by less than one gas step (with gas_dt = DEM
+    /// dt and an interval of 1: couple, one gas step, one DEM step — the paper's loop).
     pub(super) fn step(&mut self) -> Result<(), SimError> {
-        let plan = self.st.plan.clone();
-        if plan.gas && self.st.steps % plan.dem_steps_per_gas_step == 0 {
-            self.couple();
-            let dt = plan.gas_dt_s.expect("gas step chosen");
+        let plan = &self.st.plan;
+        let (gas_on, interval, particles_move) = (plan.gas, plan.coupling_interval, plan.particles_move);
+        if gas_on {
+            let dt_g = plan.gas_dt_s.expect("gas step chosen");
+            let dt = self.st.case.dem.time_step_s;
+            // Gas steps needed to reach the end of this DEM step (to within rounding).
+            let target = ((self.st.steps + 1) as f64 * dt / dt_g - 1e-9).ceil() as u64;
+            if self.st.steps % interval == 0 {
+                self.couple();
+            }
             let t = self.time();
             let gas = self.st.gas.as_mut().expect("gas");
             let t0 = std::time::Instant::now();
-            for _ in 0..plan.gas_steps_per_dem_step {
-                gas.step(dt);
+            while gas.steps() < target {
+                gas.step(dt_g);
+                if gas.steps() % watchdog::GAS_CHECK_EVERY == 0 {
+                    watchdog::check_gas(gas, dt_g, t)?;
+                }
             }
-            watchdog::check_gas(gas, dt, t)?;
             self.timers.gas += t0.elapsed().as_secs_f64();
         }
         let t0 = std::time::Instant::now();
+        let before = self.st.dem.neighbour_seconds();
         self.st.dem.step();
-        self.timers.dem += t0.elapsed().as_secs_f64();
+        let neighbours = self.st.dem.neighbour_seconds() - before;
+        self.timers.neighbours += neighbours;
+        self.timers.contacts_integration += t0.elapsed().as_secs_f64() - neighbours;
         self.st.steps += 1;
-        if plan.particles_move {
+        if particles_move {
             watchdog::check_dem(&self.st.dem, self.st.steps, self.time())?;
         }
         Ok(())

@@ -20,8 +20,8 @@ use std::path::Path;
 /// First bytes of a checkpoint, then the format number (u32, little-endian), then the state.
 const CHECKPOINT_MAGIC: &[u8; 8] = b"FLUIDBED";
 /// Bumped whenever the serialised state changes shape (format 2: the DEM's near list; 3: its
-/// contact histories in single precision).
-const CHECKPOINT_FORMAT: u32 = 3;
+/// contact histories in single precision; 4: the plan's gas step and coupling interval).
+const CHECKPOINT_FORMAT: u32 = 4;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimError {
@@ -60,10 +60,26 @@ struct State {
 /// Wall time spent per stage (seconds), for progress reports and benchmarks.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct StageTimers {
-    pub dem: f64,
-    pub gas: f64,
+    /// Near-list refreshes and Verlet-list rebuilds.
+    pub neighbours: f64,
+    /// The DEM's fused pass: contact forces, walls, gravity, drag and the AB update (one team pass).
+    pub contacts_integration: f64,
     pub voidage: f64,
+    /// Gas fields at the cells, drag on the particles and on the gas.
     pub exchange: f64,
+    pub gas: f64,
+    /// Snapshots: fields, pressure drops.
+    pub output: f64,
+}
+
+impl StageTimers {
+    /// The DEM's share: neighbours, contacts and integration.
+    pub fn dem(&self) -> f64 {
+        self.neighbours + self.contacts_integration
+    }
+    pub fn total(&self) -> f64 {
+        self.dem() + self.voidage + self.exchange + self.gas + self.output
+    }
 }
 
 pub struct Simulation {
@@ -84,7 +100,9 @@ impl Simulation {
         dem.set_frozen(case.dem.frozen);
         let grid = fluid_grid(&case);
         let gas = case.gas.as_ref().map(|_| GasSolver::new(&case, grid.clone()));
-        let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt()));
+        // The gas step: the stable step of the gas at rest or of the inlet flow, whichever is less.
+        let inflow = crate::cfd::case_stable_time_step(&case).unwrap_or(f64::INFINITY);
+        let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt().min(inflow)));
         let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas };
         let mut sim = Simulation::assemble(st, grid);
         sim.initial_voidage();
@@ -121,6 +139,19 @@ impl Simulation {
     pub fn timers(&self) -> &StageTimers {
         &self.timers
     }
+    /// Start the stage timers from zero (benchmarks).
+    pub fn reset_timers(&mut self) {
+        self.timers = StageTimers::default();
+    }
+    /// The particles, to step them without the gas (benchmarks: the DEM alone on the same bed).
+    pub fn dem_mut(&mut self) -> &mut DemSystem {
+        &mut self.st.dem
+    }
+    /// Change the coupling interval from now on (benchmarks, trade-off studies).
+    pub fn set_coupling_interval(&mut self, steps: u32) {
+        self.st.case.coupling.interval_steps = steps.max(1);
+        self.st.plan.coupling_interval = steps.max(1) as u64;
+    }
     /// Change the set superficial velocity from now on (no new ramp); used by the U_mf sweep.
     pub fn set_superficial_velocity(&mut self, u: f64) {
         if let Some(g) = self.st.case.gas.as_mut() {
@@ -155,7 +186,10 @@ impl Simulation {
             }
             self.step()?;
             if self.st.steps % self.steps_per_snapshot == 0 || self.st.steps == self.end_steps {
-                return Ok(Some(self.take_snapshot()));
+                let t0 = std::time::Instant::now();
+                let s = self.take_snapshot();
+                self.timers.output += t0.elapsed().as_secs_f64();
+                return Ok(Some(s));
             }
         }
         Ok(None)

@@ -14,12 +14,14 @@ pub struct Plan {
     pub gas: bool,
     /// Voidage, drag and the force exchange run (gas and particles both present).
     pub coupling: bool,
-    /// DEM steps per gas step (gas sub-cycled at its own stable step), or 1.
-    pub dem_steps_per_gas_step: u64,
-    /// Gas sub-steps inside one DEM step when the gas step is the smaller one, or 1.
-    pub gas_steps_per_dem_step: u64,
-    /// The gas time step actually used.
+    /// The gas time step actually used: its own stable step (or the case's, if smaller), not a
+    /// multiple of the DEM step; the gas steps whenever the DEM would pass its time (coupled.rs).
     pub gas_dt_s: Option<f64>,
+    /// Gas steps per DEM step on average (gas_dt / DEM dt inverted; below 1 the gas is sub-cycled
+    /// at the larger step).
+    pub gas_steps_per_dem_step: f64,
+    /// DEM steps between recomputations of voidage and drag (the case's `coupling.interval_steps`).
+    pub coupling_interval: u64,
     /// A voidage field is computed for snapshots (requested and a grid exists).
     pub voidage_field: bool,
     /// Particle positions go into snapshots.
@@ -31,28 +33,21 @@ impl Plan {
         let dt = case.dem.time_step_s;
         let particles_move = n_particles > 0 && !case.dem.frozen;
         let gas = case.gas.is_some();
-        let (dem_per_gas, gas_per_dem, gas_dt) = match (gas, gas_stable_dt) {
+        let gas_dt = match (gas, gas_stable_dt) {
             (true, Some(stable)) => {
                 let user = case.gas.as_ref().and_then(|g| g.time_step_s);
-                let target = user.unwrap_or(stable).min(stable);
-                if target >= dt {
-                    let k = (target / dt).floor().max(1.0) as u64;
-                    (k, 1, Some(k as f64 * dt))
-                } else {
-                    let m = (dt / target).ceil().max(1.0) as u64;
-                    (1, m, Some(dt / m as f64))
-                }
+                Some(user.unwrap_or(stable).min(stable))
             }
-            _ => (1, 1, None),
+            _ => None,
         };
         Plan {
             particles_move,
             tangential: particles_move && case.particles.sliding_friction > 0.0,
             gas,
             coupling: gas && n_particles > 0,
-            dem_steps_per_gas_step: dem_per_gas,
-            gas_steps_per_dem_step: gas_per_dem,
             gas_dt_s: gas_dt,
+            gas_steps_per_dem_step: gas_dt.map_or(0.0, |g| dt / g),
+            coupling_interval: case.coupling.interval_steps.max(1) as u64,
             voidage_field: case.outputs.fields.contains(&Field::Voidage) || gas,
             particle_field: case.outputs.fields.contains(&Field::Particles),
         }

@@ -29,6 +29,7 @@ pub fn test_case(col_d: f64, height: f64, lid: bool, gravity: f64, dt: f64) -> C
         gas: None,
         grid: Default::default(),
         voidage: Default::default(),
+        coupling: Default::default(),
     };
     c.dem.time_step_s = dt;
     c

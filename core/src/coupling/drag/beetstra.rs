@@ -1,10 +1,8 @@
 //! Beetstra, van der Hoef & Kuipers (2007) monodisperse drag, PHYSICS.md 1.1, in the model-A form
 //! of PHYSICS.md 11 (the particle also feels −V_p∇p; the gas loses the drag alone).
 
-use std::f64::consts::PI;
-
-/// Below this Reynolds number F₁ is dropped (Re^−0.343 diverges; F₁ → 0).
-const RE_GUARD: f64 = 1e-12;
+use super::{DragLaw, RE_GUARD};
+use crate::coupling::fast_math::{fast_exp, fast_ln};
 
 /// Dimensionless drag F(ε, Re) = F₀ + F₁ (PHYSICS.md 1.1), Re = ρ_g ε |u − v| d / μ:
 /// F₀ = 10φ/ε² + ε²(1 + 1.5√φ),
@@ -20,24 +18,61 @@ pub fn beetstra_f(eps: f64, re: f64) -> f64 {
     f0 + f1
 }
 
-/// Model-A drag on one particle: F_d = 3πμ d ε F(ε, Re) (u − v), Re = ρ_g ε |u − v| d/μ, with ε
-/// clamped to [eps_min, 1) (PHYSICS.md 1.1). `slip` = u − v (interstitial gas minus particle).
-pub fn drag_force(mu: f64, rho_g: f64, d: f64, eps: f64, eps_min: f64, slip: [f64; 3]) -> [f64; 3] {
-    let eps = eps.clamp(eps_min, 1.0 - f64::EPSILON);
-    let w = (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]).sqrt();
-    let re = rho_g * eps * w * d / mu;
-    let c = 3.0 * PI * mu * d * eps * beetstra_f(eps, re);
-    [c * slip[0], c * slip[1], c * slip[2]]
-}
-
 /// Model-A interphase coefficient β_A = 18 μ ε φ F / d² (force per volume per slip velocity).
 pub fn beta_a(mu: f64, d: f64, eps: f64, re: f64) -> f64 {
     18.0 * mu * eps * (1.0 - eps) * beetstra_f(eps, re) / (d * d)
 }
 
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Beetstra;
+
+/// F = f0 + b·Re·(c + 8.4 Re^−0.343)/(1 + p10·Re^e1): one ln and two exp per particle.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct BeetstraCell {
+    f0: f64,
+    b: f64,
+    c: f64,
+    p10: f64,
+    e1: f64,
+}
+
+impl DragLaw for Beetstra {
+    type Cell = BeetstraCell;
+    fn f(&self, eps: f64, re: f64) -> f64 {
+        beetstra_f(eps, re)
+    }
+    fn cell(&self, eps: f64) -> BeetstraCell {
+        let phi = 1.0 - eps;
+        BeetstraCell {
+            f0: 10.0 * phi / (eps * eps) + eps * eps * (1.0 + 1.5 * phi.max(0.0).sqrt()),
+            b: 0.413 / (24.0 * eps * eps),
+            c: 1.0 / eps + 3.0 * eps * phi,
+            p10: 10f64.powf(3.0 * phi),
+            e1: -(1.0 + 4.0 * phi) / 2.0,
+        }
+    }
+    #[inline(always)]
+    fn f_cell(k: &BeetstraCell, re: f64) -> f64 {
+        let l = fast_ln(re.max(RE_GUARD));
+        let f1 = k.b * re * (k.c + 8.4 * fast_exp(-0.343 * l)) / (1.0 + k.p10 * fast_exp(k.e1 * l));
+        if re < RE_GUARD {
+            k.f0
+        } else {
+            k.f0 + f1
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::coupling::drag::{drag_force, DragModel};
+    use std::f64::consts::PI;
+
+    #[test]
+    fn fast_form_matches_the_published_one() {
+        crate::coupling::drag::tests::fast_form_matches(Beetstra);
+    }
 
     #[test]
     fn reproduces_the_physics_reference_table() {
@@ -57,7 +92,7 @@ mod tests {
         assert!((beetstra_f(1.0 - 1e-10, 1e-9) - 1.0).abs() < 1e-4);
         // and the force is then 3πμ d (u − v)
         // (Re ≈ 7e-7 here; F₁ ~ Re^0.657 adds ≈ 1e-5)
-        let f = drag_force(1.8e-5, 1.2, 1e-3, 1.0, 0.1, [0.0, 0.0, 1e-8]);
+        let f = drag_force(DragModel::Beetstra, 1.8e-5, 1.2, 1e-3, 1.0, 0.1, [0.0, 0.0, 1e-8]);
         assert!((f[2] / (3.0 * PI * 1.8e-5 * 1e-3 * 1e-8) - 1.0).abs() < 1e-4);
     }
 
@@ -65,7 +100,7 @@ mod tests {
     fn beta_a_matches_the_particle_force_per_volume() {
         // β_A·(u−v) = n·F_d with n = φ/V_p
         let (mu, rho, d, eps, w) = (1.8e-5, 1.204, 1.2e-3, 0.45, 0.7);
-        let fd = drag_force(mu, rho, d, eps, 0.1, [0.0, 0.0, w])[2];
+        let fd = drag_force(DragModel::Beetstra, mu, rho, d, eps, 0.1, [0.0, 0.0, w])[2];
         let vp = PI * d * d * d / 6.0;
         let re = rho * eps * w * d / mu;
         assert!((beta_a(mu, d, eps, re) * w - (1.0 - eps) / vp * fd).abs() < 1e-9 * fd / vp);
@@ -76,7 +111,7 @@ mod tests {
         let (rho, rho_p, d, g) = (1.204, 1000.0, 1.2e-3, 9.81);
         let vp = PI * d * d * d / 6.0;
         let excess = |u0: f64| {
-            let fd = drag_force(mu, rho, d, eps, 0.1, [0.0, 0.0, u0 / eps])[2];
+            let fd = drag_force(DragModel::Beetstra, mu, rho, d, eps, 0.1, [0.0, 0.0, u0 / eps])[2];
             fd / eps - (rho_p - rho) * vp * g
         };
         let (mut lo, mut hi) = (1e-4, 5.0);
@@ -108,7 +143,7 @@ mod tests {
         // the model-A balance solved for −∇p gives the same particle equilibrium
         let (mu, rho, rho_p, d, g, eps) = (1.8e-5, 1.204, 1000.0, 1.2e-3, 9.81, 0.40);
         let vp = PI * d * d * d / 6.0;
-        let fd = drag_force(mu, rho, d, eps, 0.1, [0.0, 0.0, u / eps])[2];
+        let fd = drag_force(DragModel::Beetstra, mu, rho, d, eps, 0.1, [0.0, 0.0, u / eps])[2];
         let grad = ((1.0 - eps) / vp * fd + eps * rho * g) / eps;
         assert!(((rho_p * vp * g - vp * grad) / fd - 1.0).abs() < 1e-9);
     }

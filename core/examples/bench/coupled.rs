@@ -1,0 +1,163 @@
+//! Coupled-step benchmark: the 44-mm bubbling bed as shipped (cases/bubbling-44mm.json), from a
+//! fluidized state (0.3 s simulated, made once and cached under target/), 2,000 DEM steps each
+//! of: the case's default coupling, the paper's every-step coupling (interval 1, the gas at its
+//! own stable step as in both), and the same particles stepped by the DEM alone (gas off). The
+//! three run interleaved in one process (rounds of 250 steps), so their ratio is not at the mercy
+//! of the VM's speed swings. gas_coupling_share = 1 − DEM-alone step / coupled step.
+
+use fluidbed_core::case::Case;
+use fluidbed_core::sim::{Simulation, StageTimers};
+use serde_json::json;
+use std::path::PathBuf;
+use std::time::Instant;
+
+const FLUIDIZED_AT_S: f64 = 0.3;
+const STEPS: u64 = 2000;
+const ROUND: u64 = 250;
+
+fn cache_dir() -> PathBuf {
+    let d =
+        PathBuf::from(std::env::var("FLUIDBED_BENCH_CACHE").unwrap_or_else(|_| "target/fluidbed-bench-cache".into()));
+    std::fs::create_dir_all(&d).expect("bench cache dir");
+    d
+}
+
+pub fn shipped_case(name: &str) -> Case {
+    let path = format!("{}/../cases/{name}", env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0
+}
+
+/// The checkpoint of `case` run to `t_end` from its poured bed, cached by the case's text; a
+/// cache the current build cannot read is made again.
+pub fn state_at(case: &Case, t_end: f64, label: &str) -> Vec<u8> {
+    let key = {
+        use std::hash::{Hash, Hasher};
+        let mut h = std::collections::hash_map::DefaultHasher::new();
+        serde_json::to_string(case).expect("case").hash(&mut h);
+        t_end.to_bits().hash(&mut h);
+        h.finish()
+    };
+    let file = cache_dir().join(format!("{label}-{key:016x}.ckpt"));
+    if let Ok(bytes) = std::fs::read(&file) {
+        if Simulation::restore(&bytes).is_ok() {
+            return bytes;
+        }
+        eprintln!("[{label}] cached state unreadable by this build; making it again");
+    }
+    let bed = PathBuf::from(std::env::var("FLUIDBED_BED_CACHE").unwrap_or_else(|_| "target/fluidbed-bed-cache".into()));
+    let mut sim = Simulation::new(case.clone(), Some(&bed)).expect("case builds");
+    let t0 = Instant::now();
+    eprintln!("[{label}] running {} particles to t = {t_end} s (cached for later runs)", sim.dem().len());
+    while sim.time() < t_end - 1e-12 {
+        let left = ((t_end - sim.time()) / case.dem.time_step_s).round() as u64;
+        if let Some(s) = sim.advance(left.max(1)).expect("run stays stable") {
+            if s.index % 10 == 0 {
+                eprintln!(
+                    "[{label}] t = {:.3} s, ΔP = {:?} Pa, wall {:.0} s",
+                    s.time_s,
+                    s.pressure_drop_pa.map(|x| x.round()),
+                    t0.elapsed().as_secs_f64()
+                );
+            }
+        }
+    }
+    let bytes = sim.checkpoint();
+    let tmp = file.with_extension("tmp");
+    std::fs::write(&tmp, &bytes).expect("write cache");
+    std::fs::rename(&tmp, &file).expect("cache in place");
+    bytes
+}
+
+/// One mode's accumulated wall time and stage timers.
+#[derive(Default)]
+pub struct Tally {
+    pub wall: f64,
+    pub steps: u64,
+    pub stages: StageTimers,
+}
+
+impl Tally {
+    pub fn per_step(&self) -> f64 {
+        self.wall / self.steps as f64
+    }
+    pub fn stages_json(&self) -> serde_json::Value {
+        let n = self.steps as f64;
+        let s = &self.stages;
+        json!({"neighbours": s.neighbours / n, "contacts_integration": s.contacts_integration / n,
+               "voidage": s.voidage / n, "exchange": s.exchange / n, "gas": s.gas / n, "output": s.output / n})
+    }
+}
+
+/// `steps` coupled steps of `sim` (snapshots as they fall), added to `t`.
+pub fn coupled_round(sim: &mut Simulation, steps: u64, t: &mut Tally) {
+    sim.reset_timers();
+    let t0 = Instant::now();
+    let mut left = steps;
+    while left > 0 {
+        let before = sim.steps();
+        sim.advance(left).expect("coupled run stays stable");
+        left -= sim.steps() - before;
+    }
+    t.wall += t0.elapsed().as_secs_f64();
+    t.steps += steps;
+    add(&mut t.stages, sim.timers());
+}
+
+/// `steps` steps of the particles alone (no drag, no gas), added to `t`.
+pub fn dem_round(sim: &mut Simulation, steps: u64, t: &mut Tally) {
+    let dem = sim.dem_mut();
+    dem.external_forces_mut().fill([0.0; 3]);
+    let n0 = dem.neighbour_seconds();
+    let t0 = Instant::now();
+    for _ in 0..steps {
+        dem.step();
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    let nb = dem.neighbour_seconds() - n0;
+    t.wall += wall;
+    t.steps += steps;
+    t.stages.neighbours += nb;
+    t.stages.contacts_integration += wall - nb;
+}
+
+fn add(a: &mut StageTimers, b: &StageTimers) {
+    a.neighbours += b.neighbours;
+    a.contacts_integration += b.contacts_integration;
+    a.voidage += b.voidage;
+    a.exchange += b.exchange;
+    a.gas += b.gas;
+    a.output += b.output;
+}
+
+pub fn run() {
+    let case = shipped_case("bubbling-44mm.json");
+    let state = state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm");
+    let restore = || Simulation::restore(&state).expect("cached state");
+    let (mut alone, mut default, mut paper) = (restore(), restore(), restore());
+    paper.set_coupling_interval(1);
+    let (mut ta, mut td, mut tp) = (Tally::default(), Tally::default(), Tally::default());
+    for _ in 0..STEPS / ROUND {
+        dem_round(&mut alone, ROUND, &mut ta);
+        coupled_round(&mut default, ROUND, &mut td);
+        coupled_round(&mut paper, ROUND, &mut tp);
+    }
+    let dt = case.dem.time_step_s;
+    let plan = default.plan();
+    let share = |t: &Tally| 1.0 - ta.per_step() / t.per_step();
+    for (name, t) in [("dem_alone", &ta), ("default", &td), ("paper", &tp)] {
+        println!(
+            "{}",
+            json!({"bench": "coupled_mode", "mode": name, "s_per_step": t.per_step(), "stages_s_per_step": t.stages_json()})
+        );
+    }
+    println!(
+        "{}",
+        json!({"bench": "coupled", "particles": default.dem().len(), "cells": default.grid().num_cells(), "steps": STEPS,
+            "threads": rayon::current_num_threads(), "coupling_interval": plan.coupling_interval, "gas_dt_s": plan.gas_dt_s,
+            "dem_dt_s": dt, "dem_alone_s_per_step": ta.per_step(), "coupled_s_per_step": td.per_step(),
+            "gas_coupling_share": share(&td), "wall_s_per_sim_s": td.per_step() / dt, "stages": td.stages_json(),
+            "paper_coupling_interval": 1, "paper_dem_alone_s_per_step": ta.per_step(), "paper_coupled_s_per_step": tp.per_step(),
+            "paper_gas_coupling_share": share(&tp), "paper_wall_s_per_sim_s": tp.per_step() / dt, "paper_stages": tp.stages_json()})
+    );
+}
