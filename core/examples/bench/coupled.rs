@@ -161,3 +161,79 @@ pub fn run() {
             "paper_gas_coupling_share": share(&tp), "paper_wall_s_per_sim_s": tp.per_step() / dt, "paper_stages": tp.stages_json()})
     );
 }
+
+/// The coupling's parts one by one on the fluidized state (`bench -- coupled-parts`): ms per call.
+pub fn parts() {
+    use fluidbed_core::coupling::{build_voidage, voidage_from_solid, Exchange, ExchangeParams, GasAtCells};
+    let case = shipped_case("bubbling-44mm.json");
+    let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
+    let (grid, dem, gas) = (sim.grid(), sim.dem(), sim.gas().expect("gas"));
+    let n = grid.num_cells();
+    let reps = 200;
+    let time = |label: &str, f: &mut dyn FnMut()| {
+        f();
+        let t0 = Instant::now();
+        for _ in 0..reps {
+            f();
+        }
+        let ms = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
+        println!("{}", json!({"bench": "coupled_part", "part": label, "ms_per_call": ms, "ns_per_particle": ms * 1e6 / dem.len() as f64}));
+    };
+    let mut method = build_voidage(&case, grid);
+    let (mut solid, mut eps) = (vec![0.0; n], vec![0.0; n]);
+    time("voidage_solid_volume", &mut || method.solid_volume(dem.positions(), dem.radius(), &mut solid));
+    time("voidage_from_solid", &mut || voidage_from_solid(grid, &solid, &mut eps));
+    let (mut vel, mut rho, mut grad) = (vec![[0.0; 3]; n], vec![0.0; n], vec![[0.0; 3]; n]);
+    time("gas_exchange_fields", &mut || gas.exchange_fields(&mut vel, &mut rho, &mut grad));
+    let g = case.gas.as_ref().expect("gas");
+    let par = ExchangeParams { law: case.coupling.drag_law, mu: g.viscosity_pa_s, eps_min: g.drag_voidage_min, d: 2.0 * dem.radius() };
+    let at = GasAtCells { velocity_cyl: &vel, density: &rho, grad_p_cyl: &grad, voidage: &eps };
+    let mut ex = Exchange::new(grid, dem.len());
+    let (mut f, mut cf) = (vec![[0.0; 3]; dem.len()], vec![[0.0; 3]; n]);
+    time("particle_gas_forces", &mut || ex.particle_gas_forces(grid, &at, par, (dem.positions(), dem.velocities()), &mut f, &mut cf));
+    let mut gas2 = gas.clone();
+    let dt = sim.plan().gas_dt_s.expect("gas dt");
+    time("gas_step", &mut || gas2.step(dt));
+}
+
+/// Micro-timings of the particle pass's pieces (diagnostic).
+pub fn micro() {
+    use fluidbed_core::coupling::drag::{Beetstra, DragLaw};
+    use fluidbed_core::coupling::fast_math::{fast_exp, fast_ln};
+    let case = shipped_case("bubbling-44mm.json");
+    let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
+    let (grid, dem) = (sim.grid(), sim.dem());
+    let pos = dem.positions();
+    let n = pos.len();
+    let hints: Vec<usize> = pos.iter().map(|p| grid.locate(p[0], p[1], p[2])).collect();
+    let reps = 50;
+    let mut acc = 0usize;
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        for (p, &h) in pos.iter().zip(&hints) {
+            acc += grid.locate_near(p[0], p[1], p[2], h);
+        }
+    }
+    println!("locate_near with hint: {:.1} ns ({acc})", t0.elapsed().as_secs_f64() * 1e9 / (reps * n) as f64);
+    let t0 = Instant::now();
+    for _ in 0..reps {
+        for p in pos {
+            acc += grid.locate(p[0], p[1], p[2]);
+        }
+    }
+    println!("locate: {:.1} ns ({acc})", t0.elapsed().as_secs_f64() * 1e9 / (reps * n) as f64);
+    let held = hints.iter().zip(pos).filter(|(&h, p)| grid.locate_near(p[0], p[1], p[2], h) == h).count();
+    println!("hints that hold: {held} of {n}");
+    let c = Beetstra.cell(0.55);
+    let mut s = 0.0;
+    let t0 = Instant::now();
+    for k in 0..reps * n {
+        s += Beetstra::f_cell(&c, 1.0 + (k % 1000) as f64 * 0.07);
+    }
+    println!("f_cell: {:.1} ns ({s})", t0.elapsed().as_secs_f64() * 1e9 / (reps * n) as f64);
+    let t0 = Instant::now();
+    for k in 0..reps * n {
+        s += fast_exp(fast_ln(1.0 + (k % 1000) as f64 * 0.07));
+    }
+    println!("fast exp(ln): {:.1} ns ({s})", t0.elapsed().as_secs_f64() * 1e9 / (reps * n) as f64);
+}

@@ -4,6 +4,7 @@
 mod cfd;
 mod coupled;
 mod dem;
+mod tradeoff;
 mod voidage;
 
 fn main() {
@@ -11,6 +12,9 @@ fn main() {
     match what.as_str() {
         "cfd" => cfd::run(),
         "coupled" => coupled::run(),
+        "coupled-parts" => coupled::parts(),
+        "coupled-micro" => coupled::micro(),
+        "tradeoff" => tradeoff::run(),
         "dem" => dem::run(),
         "voidage" => voidage::run(),
         other => {

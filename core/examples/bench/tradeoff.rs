@@ -1,0 +1,217 @@
+//! Run time against error (`bench -- tradeoff`). Two parts:
+//! 1. Coupled runs on a 22-mm bed of the paper's particles (4.9k, E = 120 MPa, DEM step 1.25 µs,
+//!    dz = dr/2), fluidized at 0.6 m/s: from a state at 0.2 s (made once and cached) each knob's
+//!    setting runs 0.3 s with snapshots every 2 ms. Cost = wall seconds per simulated second; the
+//!    errors, against the paper's every-step coupling, in the ΔP mean, standard deviation and
+//!    dominant frequency and the time-averaged voidage (layer means; annulus means over the bed),
+//!    beside the noise floor: the same reference from a second poured bed (seed 2). An error below
+//!    the floor is inside the noise.
+//! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
+//!    cost per particle per call and per DEM step at the case's coupling interval.
+//! Last line: {"bench":"tradeoff","default_voidage","default_l1","default_ns_per_particle",
+//! "paper_sg3_l1","paper_sg3_ns_per_particle"} (per DEM step: the default at its interval, the
+//! paper's square grid configuration 3 at every step).
+
+use crate::coupled::{shipped_case, state_at};
+use fluidbed_core::case::{BoxSplit, Case, Voidage};
+use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
+use fluidbed_core::grid::CylGrid;
+use fluidbed_core::sim::{fluid_grid, Simulation, Snapshot};
+use rand::{Rng, SeedableRng};
+use serde_json::json;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+const SPIN_UP_S: f64 = 0.2;
+const WINDOW_S: f64 = 0.3;
+
+/// The trade-off bed: the quickstart's 22-mm column with the paper's particles and DEM step.
+fn bed(seed: u64) -> Case {
+    let mut c = shipped_case("quickstart.json");
+    c.particles.youngs_modulus_pa = 1.2e8;
+    c.dem.time_step_s = 1.25e-6;
+    c.grid.dz_m = Some(c.grid.dr_m / 2.0);
+    c.column.height_m = (c.column.height_m / (c.grid.dr_m / 2.0)).round() * c.grid.dr_m / 2.0;
+    c.outputs.snapshot_interval_s = 0.002;
+    c.outputs.fields = vec![fluidbed_core::case::Field::Voidage, fluidbed_core::case::Field::Pressure];
+    c.end_time_s = SPIN_UP_S + WINDOW_S;
+    if let fluidbed_core::case::Bed::Generated(g) = &mut c.bed {
+        g.seed = seed;
+    }
+    c
+}
+
+/// What a window of snapshots says about the bed.
+struct Stats {
+    dp_mean: f64,
+    dp_std: f64,
+    dp_freq: f64,
+    axial: Vec<f64>,
+    radial: Vec<f64>,
+}
+
+fn stats(snaps: &[Snapshot], grid: &CylGrid) -> Stats {
+    let dp: Vec<f64> = snaps.iter().filter_map(|s| s.pressure_drop_pa).collect();
+    let n = dp.len() as f64;
+    let mean = dp.iter().sum::<f64>() / n;
+    let std = (dp.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / n).sqrt();
+    // Dominant frequency: the largest periodogram bin above zero (resolution 1/window).
+    let dt = snaps[1].time_s - snaps[0].time_s;
+    let (mut best, mut freq) = (0.0, 0.0);
+    for k in 1..dp.len() / 2 {
+        let (mut re, mut im) = (0.0, 0.0);
+        for (m, x) in dp.iter().enumerate() {
+            let a = 2.0 * PI * (k * m) as f64 / n;
+            re += (x - mean) * a.cos();
+            im += (x - mean) * a.sin();
+        }
+        if re * re + im * im > best {
+            best = re * re + im * im;
+            freq = k as f64 / (n * dt);
+        }
+    }
+    let per = grid.cells_per_layer();
+    let mut axial = vec![0.0; grid.nz];
+    let mut radial = vec![0.0; grid.nr];
+    let bed_layers = (0.04 / grid.dz) as usize;
+    for s in snaps {
+        let e = s.voidage.as_ref().expect("voidage field");
+        for k in 0..grid.nz {
+            axial[k] += e[k * per..(k + 1) * per].iter().sum::<f64>() / per as f64 / snaps.len() as f64;
+        }
+        for k in 0..bed_layers.min(grid.nz) {
+            let mut c = k * per;
+            for (i, r) in radial.iter_mut().enumerate() {
+                let m = grid.cells_in_annulus(i);
+                *r += e[c..c + m].iter().sum::<f64>() / (m * bed_layers * snaps.len()) as f64;
+                c += m;
+            }
+        }
+    }
+    Stats { dp_mean: mean, dp_std: std, dp_freq: freq, axial, radial }
+}
+
+fn l1(a: &[f64], b: &[f64]) -> f64 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).sum::<f64>() / a.len() as f64
+}
+
+/// The errors of `s` against `r`, relative for the ΔP figures.
+fn errors(s: &Stats, r: &Stats) -> serde_json::Value {
+    json!({"dp_mean": (s.dp_mean / r.dp_mean - 1.0).abs(), "dp_std": (s.dp_std / r.dp_std - 1.0).abs(),
+           "dp_freq_hz": (s.dp_freq - r.dp_freq).abs(), "voidage_axial_l1": l1(&s.axial, &r.axial),
+           "voidage_radial_l1": l1(&s.radial, &r.radial)})
+}
+
+/// Run `case` over the window from its cached spin-up state with `interval`: snapshots, cost.
+fn window(case: &Case, label: &str, interval: u32) -> (Vec<Snapshot>, f64) {
+    let state = state_at(case, SPIN_UP_S, label);
+    let mut sim = Simulation::restore(&state).expect("state");
+    sim.set_coupling_interval(interval);
+    let mut snaps = Vec::new();
+    let t0 = Instant::now();
+    while !sim.is_finished() {
+        if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
+            snaps.push(s);
+        }
+    }
+    let wall = t0.elapsed().as_secs_f64();
+    (snaps, wall / WINDOW_S)
+}
+
+fn coupled_front() -> f64 {
+    let reference = bed(1);
+    let (ref_snaps, ref_cost) = window(&reference, "tradeoff-seed1", 1);
+    let grid = fluid_grid(&reference);
+    let r = stats(&ref_snaps, &grid);
+    let (floor_snaps, _) = window(&bed(2), "tradeoff-seed2", 1);
+    let floor = errors(&stats(&floor_snaps, &grid), &r);
+    println!("{}", json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1", "errors": floor}));
+    println!("{}", json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": 1, "wall_s_per_sim_s": ref_cost,
+        "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq}));
+    let mut default_cost = ref_cost;
+    for interval in [2u32, 5, 10, 20] {
+        let (snaps, cost) = window(&reference, "tradeoff-seed1", interval);
+        let s = stats(&snaps, &grid);
+        if interval == reference.coupling.interval_steps {
+            default_cost = cost;
+        }
+        println!("{}", json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": interval,
+            "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq}));
+    }
+    let mut exact = reference.clone();
+    exact.voidage = Voidage::ExactCylindrical;
+    let (snaps, cost) = window(&exact, "tradeoff-exact", exact.coupling.interval_steps);
+    println!("{}", json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
+        "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)}));
+    default_cost
+}
+
+/// Random packing of mean voidage `eps` (centres uniform, overlaps allowed: the methods are linear).
+fn packing(g: &CylGrid, eps: f64, a: f64, seed: u64) -> Vec<[f64; 3]> {
+    let n = ((1.0 - eps) * PI * g.radius * g.radius * g.height / (4.0 / 3.0 * PI * a * a * a)).round() as usize;
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    (0..n)
+        .map(|_| {
+            let r = (g.radius - a) * rng.gen::<f64>().sqrt();
+            let t = rng.gen_range(0.0..2.0 * PI);
+            [r * t.cos(), r * t.sin(), rng.gen_range(a..g.height - a)]
+        })
+        .collect()
+}
+
+/// Mean L1 over three packings and ns per particle per call of `make`'s method.
+fn voidage_point(g: &CylGrid, a: f64, make: &dyn Fn() -> Box<dyn VoidageMethod>) -> (f64, f64) {
+    let (mut l1_sum, mut ns_sum) = (0.0, 0.0);
+    let n = g.num_cells();
+    let (mut solid, mut e, mut e_ref) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+    for (k, eps) in [0.4, 0.6, 0.9].into_iter().enumerate() {
+        let pos = packing(g, eps, a, 200 + k as u64);
+        ExactCylindrical::with_nodes(g, 48).solid_volume(&pos, a, &mut solid);
+        voidage_from_solid(g, &solid, &mut e_ref);
+        let mut m = make();
+        m.solid_volume(&pos, a, &mut solid);
+        voidage_from_solid(g, &solid, &mut e);
+        l1_sum += l1(&e, &e_ref);
+        let (t0, mut reps) = (Instant::now(), 0);
+        while reps < 3 || t0.elapsed().as_secs_f64() < 0.2 {
+            m.solid_volume(&pos, a, &mut solid);
+            reps += 1;
+        }
+        ns_sum += t0.elapsed().as_secs_f64() * 1e9 / (reps * pos.len()) as f64;
+    }
+    (l1_sum / 3.0, ns_sum / 3.0)
+}
+
+pub fn run() {
+    let skip_runs = std::env::args().nth(2).as_deref() == Some("voidage");
+    if !skip_runs {
+        coupled_front();
+    }
+    let case = shipped_case("bubbling-44mm.json");
+    let mut g = fluid_grid(&case);
+    g = CylGrid::new(g.radius, 20.0 * g.dz, g.dr, g.dz, g.n0);
+    let a = case.particles.diameter_m / 2.0;
+    let interval = case.coupling.interval_steps as f64;
+    let sg3 = || -> Box<dyn VoidageMethod> { Box::new(SquareGrid::new(&g, 1.375e-3, BoxSplit::Cuboid, 1.0)) };
+    let (sg3_l1, sg3_ns) = voidage_point(&g, a, &sg3);
+    println!("{}", json!({"bench": "tradeoff_voidage", "method": "square_grid cuboid config 3", "l1": sg3_l1, "ns_per_particle_call": sg3_ns}));
+    let mut best: Option<(String, f64, f64)> = None;
+    for nodes in [2usize, 3, 4] {
+        let (l, ns) = voidage_point(&g, a, &|| Box::new(ExactCylindrical::with_nodes(&g, nodes)));
+        println!("{}", json!({"bench": "tradeoff_voidage", "method": format!("exact_cylindrical {nodes} nodes"), "l1": l,
+            "ns_per_particle_call": ns, "ns_per_particle_step_at_default_interval": ns / interval}));
+        if best.as_ref().is_none_or(|b| ns < b.2) {
+            best = Some((format!("exact_cylindrical {nodes} nodes"), l, ns));
+        }
+    }
+    let (default_name, default_l1, default_ns) = match &case.voidage {
+        Voidage::SquareGrid { .. } => ("square_grid cuboid config 3".to_string(), sg3_l1, sg3_ns),
+        _ => best.expect("exact points"),
+    };
+    println!(
+        "{}",
+        json!({"bench": "tradeoff", "default_voidage": format!("{default_name}, coupling every {interval} DEM steps"),
+            "default_l1": default_l1, "default_ns_per_particle": default_ns / interval,
+            "paper_sg3_l1": sg3_l1, "paper_sg3_ns_per_particle": sg3_ns})
+    );
+}
