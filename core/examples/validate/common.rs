@@ -73,10 +73,10 @@ pub fn gradient_and_voidage(s: &Snapshot, k1: usize, k2: usize) -> (f64, f64) {
     let grad = (p[k1] - p[k2]) / ((k2 - k1) as f64 * dz);
     let mut w = 0.0;
     let mut sum = 0.0;
-    for k in k1..=k2 {
+    for (k, &ek) in e.iter().enumerate().take(k2 + 1).skip(k1) {
         let wk = if k == k1 || k == k2 { 0.5 } else { 1.0 };
         w += wk;
-        sum += wk * e[k];
+        sum += wk * ek;
     }
     (grad, sum / w)
 }

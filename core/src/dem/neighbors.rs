@@ -132,8 +132,8 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
                                 continue;
                             }
                             let lo = (start[cc] as usize).max(i + 1);
-                            for j in lo..start[cc + 1] as usize {
-                                let d = [x[j][0] - xi[0], x[j][1] - xi[1], x[j][2] - xi[2]];
+                            for (j, xj) in x.iter().enumerate().take(start[cc + 1] as usize).skip(lo) {
+                                let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                                 let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                                 if r2 < c2 {
                                     row.push(((r2.sqrt() - diameter) as f32, j as u32));

@@ -168,9 +168,9 @@ impl Batch {
 fn lane_max<T: Copy + PartialOrd>(n: usize, start: T, value: impl Fn(usize) -> T) -> T {
     let mut part = [start; 8];
     for g in 0..n / 8 {
-        for q in 0..8 {
+        for (q, p) in part.iter_mut().enumerate() {
             let x = value(8 * g + q);
-            part[q] = if x > part[q] { x } else { part[q] };
+            *p = if x > *p { x } else { *p };
         }
     }
     for l in n / 8 * 8..n {

@@ -308,11 +308,11 @@ mod tests {
                 let tv = _mm256_loadu_si256(t.as_ptr() as *const __m256i);
                 let r = Rows::new(p, i0, rows[nvalid - 1], len, tv, mask);
                 let s = Slots::new(hist.as_ptr() as *const f32, i0, rows[nvalid - 1], len, tv, mask);
-                for q in 0..3 {
+                for q in [0, 1, 2] {
                     let got: [f64; 8] = std::mem::transmute(r.component(q));
                     let got_hist: [f32; 8] = std::mem::transmute(s.component(q));
-                    for lane in 0..8 {
-                        let want = if mask >> lane & 1 == 1 { data[rows[lane]][q] } else { 0.0 };
+                    for (lane, &row) in rows.iter().enumerate() {
+                        let want = if mask >> lane & 1 == 1 { data[row][q] } else { 0.0 };
                         assert_eq!(
                             got[lane], want,
                             "case {case}: span {span}, first row {i0}, lane {lane}, component {q}"

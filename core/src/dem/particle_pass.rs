@@ -57,8 +57,8 @@ fn block_forces<'o, const FR: bool>(
         if s < t {
             let buf = sc.rows(c, s, t);
             for (o, q) in out[s - lo..t - lo].iter_mut().zip(buf) {
-                for k in 0..6 {
-                    o[k] += q.0[k] as f64;
+                for (ok, &qk) in o.iter_mut().zip(&q.0[..6]) {
+                    *ok += qk as f64;
                 }
             }
         }

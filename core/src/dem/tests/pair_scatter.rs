@@ -6,10 +6,13 @@ use crate::dem::pair_batch::{Batch, CAP};
 use crate::dem::pair_scatter::{scatter, PairSum};
 use rand::{Rng, SeedableRng};
 
+/// Chunk sums, exact sums, Σ|term| per value, terms per particle.
+type Scattered = (Vec<PairSum>, Vec<[f64; 6]>, Vec<[f64; 6]>, Vec<usize>);
+
 /// Random batches (every count 1..=CAP, particles drawn from a small window so rows repeat
 /// within a batch), scattered into `acc` by `run`; returns the exact sums and, per value,
 /// Σ|term| and the number of terms.
-fn scatter_random(run: impl Fn(&Batch, &mut [PairSum])) -> (Vec<PairSum>, Vec<[f64; 6]>, Vec<[f64; 6]>, Vec<usize>) {
+fn scatter_random(run: impl Fn(&Batch, &mut [PairSum])) -> Scattered {
     let n = 40;
     let mut rng = rand::rngs::StdRng::seed_from_u64(7);
     let (mut acc, mut exact, mut abs, mut terms) =
@@ -43,7 +46,7 @@ fn scatter_random(run: impl Fn(&Batch, &mut [PairSum])) -> (Vec<PairSum>, Vec<[f
 
 #[test]
 fn chunk_sums_within_the_rounding_bound_of_the_exact_sums() {
-    let (acc, exact, abs, terms) = scatter_random(|b, acc| scatter::<true, false>(b, acc));
+    let (acc, exact, abs, terms) = scatter_random(scatter::<true, false>);
     let u = f64::from(f32::EPSILON) / 2.0;
     let mut worst: f64 = 0.0;
     for p in 0..acc.len() {
@@ -66,13 +69,10 @@ fn vector_scatter_equals_the_portable_one() {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("avx512f") && std::arch::is_x86_feature_detected!("avx512vl") {
         let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(f32::to_bits).collect::<Vec<_>>();
-        let portable = scatter_random(|b, acc| scatter::<true, false>(b, acc)).0;
-        let vector = scatter_random(|b, acc| scatter::<true, true>(b, acc)).0;
+        let portable = scatter_random(scatter::<true, false>).0;
+        let vector = scatter_random(scatter::<true, true>).0;
         assert!(bits(&portable) == bits(&vector), "vector and portable scatter differ");
-        let (portable, vector) = (
-            scatter_random(|b, acc| scatter::<false, false>(b, acc)).0,
-            scatter_random(|b, acc| scatter::<false, true>(b, acc)).0,
-        );
+        let (portable, vector) = (scatter_random(scatter::<false, false>).0, scatter_random(scatter::<false, true>).0);
         assert!(bits(&portable) == bits(&vector), "vector and portable scatter differ without friction");
         assert!(portable.iter().all(|r| r.0[3..] == [0.0; 5]), "no torque sums without friction");
     }
