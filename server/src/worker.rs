@@ -7,7 +7,7 @@ use crate::job::{now_rfc3339, SnapshotInfo, Status};
 use crate::App;
 use anyhow::Result;
 use fluidbed_core::case::Case;
-use fluidbed_core::dem::team_step::pool_with_own_team;
+use fluidbed_core::dem::solver_pool;
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::Simulation;
 use std::collections::VecDeque;
@@ -116,7 +116,7 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
     }
     let threads = app.config.threads_per_job.max(1);
     // Its own team lock, so that concurrent jobs each step DEM as a team (`team_step`).
-    let pool = pool_with_own_team().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
+    let pool = solver_pool().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
     let base_wall = job.wall_s;
     pool.install(|| drive(app, id, &cancel, base_wall))
 }

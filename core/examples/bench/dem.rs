@@ -1,6 +1,7 @@
 //! DEM throughput on the settled 44-mm bed (~25,000 particles, LIGGGHTS anchor settings):
 //! 1,000 warm-up steps, then 2,000 timed steps, once on 1 thread and once on all cores.
-//! Prints `{"bench":"dem","particles":…,"steps":…,"threads":…,"particle_steps_per_s":…}` per run.
+//! Prints `{"bench":"dem","kernel":…,"particles":…,"steps":…,"threads":…,"particle_steps_per_s":…}`
+//! per run, the kernel being the code path that ran (`FLUIDBED_KERNEL`, else the best the CPU has).
 //! `bench -- dem shaken`: the same with random initial velocities (lists refreshed often).
 //! `bench -- dem pour`: instead, time `build_bed` for the default particles poured to a settled
 //! height (7k bed: 30-mm column, 15 mm; 30k bed: 44-mm column, 30 mm), one JSON line each.
@@ -148,8 +149,9 @@ pub fn run() {
                 sys.touching_pairs().map_or("n/a (no friction)".into(), |t| format!("{:.2}", per(t)))
             );
             println!(
-                "{{\"bench\":\"{}\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",
+                "{{\"bench\":\"{}\",\"kernel\":\"{}\",\"particles\":{},\"steps\":{},\"threads\":{},\"particle_steps_per_s\":{:.0}}}",
                 if shaken { "dem_shaken" } else { "dem" },
+                sys.kernel(),
                 sys.len(),
                 timed,
                 threads,

@@ -43,7 +43,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
     // named after the case it ran, so an edited case runs anew
-    let key = fluidbed_core::dem::bed::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
+    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
     let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.json");
     let cache = cache.as_str();
     if let Some(r) = std::fs::read_to_string(cache).ok().and_then(|t| serde_json::from_str(&t).ok()) {

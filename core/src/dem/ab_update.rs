@@ -5,26 +5,35 @@
 //! left it scalar (a redundant second update of x, v and ω cost 14% of a step), so on AVX-512
 //! it is written with intrinsics: the same IEEE operations in the same order, the same bits.
 
+use super::kernel::Isa;
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
 /// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), f_older ← f (a loop the compiler vectorises).
 #[inline(always)]
-pub fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
+pub(crate) fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
     for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
         *y += hb[0] * f + hb[1] * f1 + hb[2] * *f2;
         *f2 = f;
     }
 }
 
-/// As `ab_flat`, returning (max |increment|, max |new y|) (a NaN is passed over). Panics unless
-/// the four arrays have one length.
-pub fn ab_flat_moved(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
+/// As `ab_flat`, returning (max |increment|, max |new y|) (a NaN is passed over); with AVX-512
+/// intrinsics when `isa` proves them. Panics unless the four arrays have one length.
+#[inline(always)]
+pub(crate) fn ab_flat_moved<const V: bool>(
+    isa: Isa<V>,
+    hb: [f64; 3],
+    y: &mut [f64],
+    f: &[f64],
+    newer: &[f64],
+    older: &mut [f64],
+) -> (f64, f64) {
     let n = y.len();
     assert!(f.len() == n && newer.len() == n && older.len() == n, "arrays of one length");
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f") {
-        // SAFETY: the CPU has the feature; the lengths are equal (asserted).
+    if let Some(_proof) = isa.as_avx512() {
+        // SAFETY: `_proof` shows the CPU has the feature; the lengths are equal (asserted).
         return unsafe { moved_avx512(hb, y, f, newer, older) };
     }
     moved_portable(hb, y, f, newer, older)
@@ -90,7 +99,10 @@ mod tests {
             }
             let (y0, f, f1, f2) = (arrays[0].clone(), &arrays[1], &arrays[2], arrays[3].clone());
             let (mut ya, mut oa) = (y0.clone(), f2.clone());
-            let got = ab_flat_moved(hb, &mut ya, f, f1, &mut oa);
+            let Some(isa) = Isa::avx512() else {
+                return crate::dem::tests::skip("vector_update_with_maxima_equals_the_portable_one", "no AVX-512");
+            };
+            let got = ab_flat_moved(isa, hb, &mut ya, f, f1, &mut oa);
             let (mut yb, mut ob) = (y0.clone(), f2.clone());
             let want = moved_portable(hb, &mut yb, f, f1, &mut ob);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();

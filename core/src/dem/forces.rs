@@ -9,13 +9,15 @@
 //! This file holds the shared types and pass 1. `team_step` runs both passes as one broadcast
 //! (the multistep steps); `pair_pass` alone serves the start-up and the fallback.
 
-use super::contact::{ContactLaw, V3};
+use super::batch::{Batch, Entries, Entry, PairInputs, CAP};
+use super::contact::V3;
+use super::kernel::{Isa, Kernel};
 use super::neighbors::{Hist, NeighborList};
-use super::pair_batch::{Batch, CAP};
+use super::pair_batch::evaluate;
 use super::pair_scatter::{scatter, PairSum};
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{scan8, LANES};
-pub use super::work_split::Scratch;
+pub(crate) use super::work_split::Scratch;
 use super::DemParams;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -71,24 +73,15 @@ impl Stats {
     }
 }
 
-/// Which code the pair pass runs.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kernels {
-    /// The vector kernels the CPU has (AVX-512, AVX2), picked at run time.
-    Best,
-    /// The portable code alone (tests compare the two).
-    Portable,
-}
-
-/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers.
-pub fn pair_pass<const FR: bool>(
+/// Pass 1: all listed pairs, forces and n × F_t accumulated into the chunk buffers, on the
+/// `kernel` path (the portable one when the CPU lacks it). Panics unless `sc` was planned for
+/// `nl` and the arrays hold one row per particle.
+pub(crate) fn pair_pass<const FR: bool>(
     p: &DemParams,
-    x: &[V3],
-    v: &[V3],
-    w: &[V3],
+    (x, v, w): (&[V3], &[V3], &[V3]),
     nl: &mut NeighborList,
     sc: &mut Scratch,
-    kernels: Kernels,
+    kernel: Kernel,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
@@ -103,74 +96,91 @@ pub fn pair_pass<const FR: bool>(
         (sh_rest, to_rest, acc_rest) = (r1, r2, r3);
         work.push((a, b, sh, to, acc));
     }
-    let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
-    let (law, h, audit) = (&p.pair, p.dt, p.audit);
     work.into_par_iter()
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
-            let args =
-                ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x: &x[a..e], v: &v[a..e], w: &w[a..e] };
-            match kernels {
-                Kernels::Best => chunk_pairs_dispatch::<FR>(&args, sh, to, acc),
-                Kernels::Portable => chunk_pairs::<FR, false>(&args, sh, to, acc),
-            }
+            let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (&x[a..e], &v[a..e], &w[a..e]));
+            chunk_pairs_on::<FR>(kernel, &args, sh, to, acc)
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-/// Read-only inputs of one chunk of the pair pass.
-pub(super) struct ChunkArgs<'a> {
-    pub law: &'a ContactLaw,
-    /// Measure the Coulomb excess of every contact (`DemParams::audit`).
-    pub audit: bool,
-    pub r: f64,
-    pub h: f64,
-    pub d2: f64,
-    pub a: usize,
+/// Read-only inputs of one chunk of the pair pass: rows a..b, the entries of the half list
+/// from `offsets[a]` to `offsets[b]`, and the positions, velocities and spins of the chunk's
+/// window, particles a..e (rows and partners).
+pub(crate) struct ChunkArgs<'a> {
+    pub pair: PairInputs<'a>,
+    pub entries: Entries<'a>,
     pub b: usize,
     pub offsets: &'a [u32],
-    pub nbr: &'a [u32],
-    pub owner: &'a [u32],
-    /// Positions, velocities and spins of the chunk's window, particles a..e (rows and partners).
-    pub x: &'a [V3],
-    pub v: &'a [V3],
-    pub w: &'a [V3],
 }
 
-pub(super) fn chunk_pairs_dispatch<const FR: bool>(
+impl<'a> ChunkArgs<'a> {
+    /// Chunk a..b of `p`'s pair law over the list (`offsets`, `owner`, `nbr`), window (x, v, w).
+    pub fn new(
+        p: &'a DemParams,
+        a: usize,
+        b: usize,
+        offsets: &'a [u32],
+        owner: &'a [u32],
+        nbr: &'a [u32],
+        (x, v, w): (&'a [V3], &'a [V3], &'a [V3]),
+    ) -> Self {
+        let (r, h) = (p.radius, p.dt);
+        ChunkArgs {
+            pair: PairInputs { law: &p.pair, audit: p.audit, r, h, v, w },
+            entries: Entries { owner, nbr, first: a, x, d2: 4.0 * r * r },
+            b,
+            offsets,
+        }
+    }
+}
+
+/// One chunk of the pair pass on the `kernel` path (the portable one when the CPU lacks it).
+pub(crate) fn chunk_pairs_on<const FR: bool>(
+    kernel: Kernel,
     c: &ChunkArgs,
     sh: &mut [Hist],
     to: &mut [u8],
     acc: &mut [PairSum],
 ) -> Stats {
     #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f")
-            && std::arch::is_x86_feature_detected!("avx512vl")
-            && std::arch::is_x86_feature_detected!("bmi2")
-        {
-            // SAFETY: the CPU supports the features the function is compiled for.
-            return unsafe { chunk_pairs_avx512::<FR>(c, sh, to, acc) };
+    match kernel {
+        Kernel::Avx512 => {
+            if let Some(isa) = Isa::avx512() {
+                // SAFETY: `isa` proves the features the function is compiled for.
+                return unsafe { chunk_pairs_avx512::<FR>(isa, c, sh, to, acc) };
+            }
         }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: as above.
-            return unsafe { chunk_pairs_avx2::<FR>(c, sh, to, acc) };
+        Kernel::Avx2 => {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has the feature the function is compiled for.
+                return unsafe { chunk_pairs_avx2::<FR>(c, sh, to, acc) };
+            }
         }
+        Kernel::Portable => {}
     }
-    chunk_pairs::<FR, false>(c, sh, to, acc)
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = kernel;
+    chunk_pairs::<FR, false>(Isa::PORTABLE, c, sh, to, acc)
 }
 
+/// # Safety
+/// The CPU has avx512f, avx512vl and bmi2 (which `isa` proves).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
 unsafe fn chunk_pairs_avx512<const FR: bool>(
+    isa: Isa<true>,
     c: &ChunkArgs,
     sh: &mut [Hist],
     to: &mut [u8],
     acc: &mut [PairSum],
 ) -> Stats {
-    chunk_pairs::<FR, true>(c, sh, to, acc)
+    chunk_pairs::<FR, true>(isa, c, sh, to, acc)
 }
 
+/// # Safety
+/// The CPU has avx2.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 unsafe fn chunk_pairs_avx2<const FR: bool>(
@@ -179,96 +189,91 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(
     to: &mut [u8],
     acc: &mut [PairSum],
 ) -> Stats {
-    chunk_pairs::<FR, false>(c, sh, to, acc)
+    chunk_pairs::<FR, false>(Isa::PORTABLE, c, sh, to, acc)
 }
 
 /// The pair pass over rows a..b: distance checks, touching pairs batched and evaluated, forces
 /// added into `acc` (particles a..). Particles are read only in the window a..e, and the batch
-/// lanes hold indices into it (particle − a).
+/// lanes hold indices into it (particle − a). Every index is checked (the list may come from a
+/// checkpoint): a bad one panics.
 #[inline(always)]
 fn chunk_pairs<const FR: bool, const V: bool>(
+    isa: Isa<V>,
     c: &ChunkArgs,
     sh: &mut [Hist],
     to: &mut [u8],
     acc: &mut [PairSum],
 ) -> Stats {
-    let &ChunkArgs { law, audit, r, h, d2, a, b, offsets, nbr, owner, x, v, w } = c;
+    let (e, a) = (&c.entries, c.entries.first);
+    let (owner, nbr, x, d2) = (e.owner, e.nbr, e.x, e.d2);
     acc.fill(PairSum::default());
     let mut st = Stats::ZERO;
-    let (base, end) = (offsets[a] as usize, offsets[b] as usize);
+    let (base, end) = (c.offsets[a] as usize, c.offsets[c.b] as usize);
     let mut batch = Batch::new();
     // One flat loop over the chunk's entries (the row of entry k is owner[k]): no row loop,
     // no data-dependent branch. Every entry is written into lane m; only touching ones
     // advance m.
     let mut m = 0;
-    assert!(owner.len() == nbr.len() && end <= nbr.len() && x.len() <= i32::MAX as usize / 3);
-    assert!(acc.len() == x.len() && v.len() == x.len() && (w.len() == x.len() || !FR), "chunk window");
+    assert!(owner.len() == nbr.len() && base <= end && end <= nbr.len(), "chunk entries");
+    assert!(acc.len() == x.len() && c.pair.v.len() == x.len() && (c.pair.w.len() == x.len() || !FR), "chunk window");
+    assert!(!FR || (sh.len() == end - base && to.len() == end - base), "chunk histories");
     let mut k = base;
     #[cfg(target_arch = "x86_64")]
-    if V {
+    if let Some(avx) = isa.as_avx512() {
         while k + LANES <= end {
             if m > CAP - LANES {
                 batch.m = m;
-                flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
+                flush::<FR, V>(isa, &mut batch, &c.pair, sh, base, acc, &mut st);
                 m = 0;
             }
-            // SAFETY: V is set only by the caller compiled for (and checked to have) the
-            // features; bounds as asserted above and in `Scratch::plan`.
-            m = unsafe { scan8::<FR>(k, base, a, owner, nbr, x, d2, to, &mut batch, m) };
+            m = scan8::<FR>(avx, e, k, base, to, &mut batch, m);
             k += LANES;
         }
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
+            flush::<FR, V>(isa, &mut batch, &c.pair, sh, base, acc, &mut st);
             m = 0;
         }
     }
     for k in k..end {
-        // SAFETY: k < end ≤ nbr.len() = owner.len() (asserted); `Scratch::plan` checked
-        // a ≤ i < j < e for every pair of the chunk, and the chunk's `to` covers k - base.
-        let (i, j) = unsafe { (*owner.get_unchecked(k) as usize - a, *nbr.get_unchecked(k) as usize - a) };
-        let (xi, xj) = unsafe { (*x.get_unchecked(i), *x.get_unchecked(j)) };
+        let (i, j) = (owner[k].wrapping_sub(a as u32) as usize, nbr[k].wrapping_sub(a as u32) as usize);
+        let (xi, xj) = (x[i], x[j]);
         let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
         let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];
         let touching = r2 < d2;
         if FR {
             // The history is live only while the pair keeps touching.
-            let t = unsafe { to.get_unchecked_mut(k - base) };
+            let t = &mut to[k - base];
             batch.was[m] = *t;
             *t = touching as u8;
         }
-        batch.set(m, k, i, j, dx, r2, d2);
+        batch.set(m, Entry { k, i, j }, dx, r2, d2);
         m += touching as usize;
         if m == CAP {
             batch.m = m;
-            flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
+            flush::<FR, V>(isa, &mut batch, &c.pair, sh, base, acc, &mut st);
             m = 0;
         }
     }
     batch.m = m;
-    flush::<FR, V>(&mut batch, law, audit, r, h, v, w, sh, base, acc, &mut st);
+    flush::<FR, V>(isa, &mut batch, &c.pair, sh, base, acc, &mut st);
     st
 }
 
 /// Evaluate a batch and add its forces into `acc` (the chunk window, as the lane indices).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn flush<const FR: bool, const V: bool>(
+    isa: Isa<V>,
     batch: &mut Batch,
-    law: &ContactLaw,
-    audit: bool,
-    r: f64,
-    h: f64,
-    v: &[V3],
-    w: &[V3],
+    inp: &PairInputs,
     sh: &mut [Hist],
     base: usize,
     acc: &mut [PairSum],
     st: &mut Stats,
 ) {
-    let (ov, ex) = batch.evaluate::<FR, V>(law, audit, r, h, v, w, sh, base);
+    let (ov, ex) = evaluate::<FR, V>(isa, batch, inp, sh, base);
     st.overlap = st.overlap.max(ov);
     st.coulomb_excess = st.coulomb_excess.max(ex);
-    scatter::<FR, V>(batch, acc);
+    scatter::<FR, V>(isa, batch, acc);
     batch.m = 0;
 }

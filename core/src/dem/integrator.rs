@@ -16,18 +16,9 @@ pub fn weights(levels: u8) -> [f64; 3] {
     }
 }
 
-/// One multistep update of a 3-vector: y + h(b0 f0 + b1 f1 + b2 f2).
-#[inline(always)]
-pub fn ab_update(y: [f64; 3], f0: [f64; 3], f1: [f64; 3], f2: [f64; 3], hb: [f64; 3]) -> [f64; 3] {
-    let mut out = y;
-    for k in 0..3 {
-        out[k] = y[k] + (hb[0] * f0[k] + hb[1] * f1[k] + hb[2] * f2[k]);
-    }
-    out
-}
-
 /// Integrate y' = f(y) over `steps` steps of size h with the same scheme the DEM uses
 /// (Heun, AB2, then AB3). Used to check the order of the method on its own.
+#[cfg(test)]
 pub fn integrate<F: FnMut(&[f64]) -> Vec<f64>>(mut f: F, y0: &[f64], h: f64, steps: usize) -> Vec<f64> {
     let mut y = y0.to_vec();
     let mut hist: Vec<Vec<f64>> = Vec::new(); // f_{n-1}, f_{n-2}

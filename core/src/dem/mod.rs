@@ -5,41 +5,50 @@
 //! - `ab_update`: the AB update on flat arrays (with the largest move, for positions);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
 //! - `near_list`: the Verlet list's entries within a small gap, the list the pair pass walks;
+//! - `batch`: a batch of touching pairs as lanes, and the inputs the lanes are gathered from;
 //! - `pair_batch`: the same law for batches of particle pairs (the fast path);
 //! - `pair_simd`: AVX-512 scan and gather of the pair pass, eight entries at a time;
+//! - `pair_scatter`: a batch's forces added into the chunk buffers;
+//! - `kernel`: the code paths (portable, AVX2, AVX-512) and `FLUIDBED_KERNEL`;
 //! - `walls`: plate, tube and lid contacts for the particles near them;
 //! - `forces`: the pair pass of a step (deterministic, parallel) and the shared types;
 //! - `work_split`: the pair pass's chunks and their force buffers;
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
 //! - `team_step`, `steal_ranges`: both passes of a step as one team of threads sharing the work;
+//! - `team_lock`: one team per pool at a time; `solver_pool` builds a pool with its own;
 //! - `system`: `DemSystem`, the state and the step loop;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
 
-pub mod ab_update;
-pub mod bed;
-pub mod contact;
-pub mod forces;
-pub mod integrator;
-pub mod near_list;
-pub mod neighbors;
-pub mod pair_batch;
-pub mod pair_scatter;
-pub mod pair_simd;
-pub mod particle_pass;
-pub mod steal_ranges;
-pub mod system;
-pub mod team_step;
-pub mod walls;
-pub mod work_split;
+mod ab_update;
+mod batch;
+mod bed;
+mod contact;
+mod forces;
+mod integrator;
+mod kernel;
+mod near_list;
+mod neighbors;
+mod pair_batch;
+mod pair_scatter;
+mod pair_simd;
+mod particle_pass;
+mod steal_ranges;
+mod system;
+mod team_lock;
+mod team_step;
+mod walls;
+mod work_split;
 
 #[cfg(test)]
 mod tests;
 
-pub use bed::build_bed;
+pub use bed::{build_bed, fnv1a};
+pub use contact::{ContactLaw, V3};
+pub use kernel::{Kernel, KERNEL_ENV};
 pub use system::DemSystem;
+pub use team_lock::solver_pool;
 
 use crate::case::Case;
-use contact::ContactLaw;
 use serde::{Deserialize, Serialize};
 
 /// Everything a step needs that does not change during a run (from the case).

@@ -39,6 +39,7 @@ pub enum Histories<'a> {
 impl NearList {
     /// The entries of `outer` with gap < `gap` at positions `x`, or with a live history (whose
     /// history and flag come along), in `outer`'s order.
+    #[cfg(test)]
     pub fn select(outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) -> NearList {
         let mut out = NearList::default();
         out.select_into(outer, x, diameter, gap, hist, &mut Vec::new());

@@ -7,159 +7,81 @@
 //! Three phases: a scalar gather (velocities, spins and histories of the lanes' particles into
 //! lane arrays), a branch-free lane loop over independent contacts that the compiler turns into
 //! SIMD (the Coulomb limit is a select), and the history write-back. The caller (the pair pass)
-//! is compiled for AVX-512, AVX2 and baseline and picked at run time; Rust never fuses a multiply
+//! is compiled for AVX-512, AVX2 and baseline (`kernel::Kernel`); Rust never fuses a multiply
 //! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
-use super::contact::{ContactLaw, V3};
+use super::batch::{Batch, PairInputs, CAP};
+use super::contact::ContactLaw;
+use super::kernel::Isa;
 use super::neighbors::Hist;
 #[cfg(target_arch = "x86_64")]
 use super::pair_simd::{gather8, write_back8, LANES};
 
-/// Pairs per batch.
-pub const CAP: usize = 64;
-
-type Lanes = [f32; CAP];
-
-/// Touching pairs waiting for evaluation (structure of arrays over lanes).
-#[repr(C, align(64))]
-pub struct Batch {
-    pub m: usize,
-    /// List slot (for the history), first and second particle.
-    pub k: [u32; CAP],
-    pub i: [u32; CAP],
-    pub j: [u32; CAP],
-    /// x_j − x_i, its squared length r² and (2R)² − r² (formed in double, then rounded).
-    pub dx: [Lanes; 3],
-    pub r2: Lanes,
-    pub gap2: Lanes,
-    /// 1 when the pair touched in the previous step (its history is live), else 0.
-    pub was: [u8; CAP],
-    // Gathered inputs and per-lane diagnostics.
-    pub(super) vrel: [Lanes; 3],
-    pub(super) ws: [Lanes; 3],
-    pub(super) s: [Lanes; 3],
-    delta: Lanes,
-    /// (|F_t|² − (μF_n)²)/(μF_n)².
-    excess: Lanes,
-    /// Force on i, and n × F_t.
-    pub f: [Lanes; 3],
-    pub c: [Lanes; 3],
-}
-
-impl Batch {
-    pub fn new() -> Box<Batch> {
-        let z = [0.0; CAP];
-        Box::new(Batch {
-            m: 0,
-            k: [0; CAP],
-            i: [0; CAP],
-            j: [0; CAP],
-            dx: [z; 3],
-            r2: z,
-            gap2: z,
-            was: [1; CAP],
-            vrel: [z; 3],
-            ws: [z; 3],
-            s: [z; 3],
-            delta: z,
-            excess: z,
-            f: [z; 3],
-            c: [z; 3],
-        })
-    }
-
-    /// Fill lane `l` < CAP with the pair x_j − x_i = `dx`, r² = `r2`, contact at r² = `d2`
-    /// (the caller counts lanes and sets `m` before `evaluate`).
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn set(&mut self, l: usize, k: usize, i: usize, j: usize, dx: V3, r2: f64, d2: f64) {
-        let l = l % CAP; // a no-op for l < CAP that lets the compiler drop the bounds checks
-        self.k[l] = k as u32;
-        self.i[l] = i as u32;
-        self.j[l] = j as u32;
-        self.dx[0][l] = dx[0] as f32;
-        self.dx[1][l] = dx[1] as f32;
-        self.dx[2][l] = dx[2] as f32;
-        self.r2[l] = r2 as f32;
-        self.gap2[l] = (d2 - r2) as f32;
-    }
-
-    /// Evaluate every lane: fills `f` (and `c`, and the history `shear[k − base]` when FR; a lane
-    /// with `was` = 0 starts from a zero history). Returns (max overlap, max (|F_t|² − (μF_n)²) /
-    /// (μF_n)²), the second −∞ unless `audit`.
-    #[allow(clippy::too_many_arguments)]
-    #[inline(always)]
-    pub fn evaluate<const FR: bool, const V: bool>(
-        &mut self,
-        law: &ContactLaw,
-        audit: bool,
-        r: f64,
-        h: f64,
-        v: &[V3],
-        w: &[V3],
-        shear: &mut [Hist],
-        base: usize,
-    ) -> (f64, f64) {
-        let m = self.m.min(CAP);
-        let n = v.len();
-        assert!(w.len() == n || !FR);
-        let mut l0 = 0;
-        #[cfg(target_arch = "x86_64")]
-        if V {
-            assert!(n <= i32::MAX as usize / 3 && shear.len() <= i32::MAX as usize / 3);
-            for l in (0..m).step_by(LANES) {
-                let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
-                // SAFETY: V is set only by the caller compiled for (and checked to have) the
-                // features; l + 8 ≤ CAP (CAP is a multiple of 8); gather8 checks the indices.
-                unsafe { gather8::<FR>(self, l, valid, r, v, w, shear, base) };
-            }
-            l0 = m;
+/// Evaluate every lane of `b`: fills `f` (and `c`, and the history `shear[k − base]` when FR; a
+/// lane with `was` = 0 starts from a zero history). Returns (max overlap, max (|F_t|² − (μF_n)²) /
+/// (μF_n)²), the second −∞ unless `inp.audit`. Panics unless every lane's particles index
+/// `inp.v` (and `inp.w` when FR) and its slot lies in base..base + shear.len().
+#[inline(always)]
+pub(crate) fn evaluate<const FR: bool, const V: bool>(
+    isa: Isa<V>,
+    b: &mut Batch,
+    inp: &PairInputs,
+    shear: &mut [Hist],
+    base: usize,
+) -> (f64, f64) {
+    let m = b.m.min(CAP);
+    let (v, w) = (inp.v, inp.w);
+    let n = v.len();
+    assert!(w.len() == n || !FR);
+    let mut l0 = 0;
+    #[cfg(target_arch = "x86_64")]
+    if let Some(isa) = isa.as_avx512() {
+        for l in (0..m).step_by(LANES) {
+            let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
+            gather8::<FR>(isa, b, l, valid, inp, shear, base);
         }
-        for l in l0..m {
-            let (i, j) = (self.i[l] as usize, self.j[l] as usize);
-            assert!(i < n && j < n);
-            // SAFETY: checked just above (one compare for four loads).
-            let (vi, vj) = unsafe { (*v.get_unchecked(i), *v.get_unchecked(j)) };
+        l0 = m;
+    }
+    for l in l0..m {
+        let (i, j) = (b.i[l] as usize, b.j[l] as usize);
+        let (vi, vj) = (v[i], v[j]);
+        for q in 0..3 {
+            b.vrel[q][l] = (vi[q] - vj[q]) as f32;
+        }
+        if FR {
+            let (wi, wj) = (w[i], w[j]);
+            let s = shear[b.k[l] as usize - base];
+            let live = b.was[l] != 0;
             for q in 0..3 {
-                self.vrel[q][l] = (vi[q] - vj[q]) as f32;
-            }
-            if FR {
-                let (wi, wj) = unsafe { (*w.get_unchecked(i), *w.get_unchecked(j)) };
-                let s = shear[self.k[l] as usize - base];
-                let live = self.was[l] != 0;
-                for q in 0..3 {
-                    self.ws[q][l] = (r * (wi[q] + wj[q])) as f32;
-                    self.s[q][l] = if live { s[q] } else { 0.0 };
-                }
+                b.ws[q][l] = (inp.r * (wi[q] + wj[q])) as f32;
+                b.s[q][l] = if live { s[q] } else { 0.0 };
             }
         }
-        let audit = FR && audit;
-        if audit {
-            lanes::<FR, true>(self, law, 2.0 * r, h);
-        } else {
-            lanes::<FR, false>(self, law, 2.0 * r, h);
-        }
-        let max_delta = lane_max(m, 0.0f32, |l| self.delta[l]) as f64;
-        if !FR {
-            return (max_delta, f64::NEG_INFINITY);
-        }
-        let max_excess =
-            if audit { lane_max(m, f32::NEG_INFINITY, |l| self.excess[l]) as f64 } else { f64::NEG_INFINITY };
-        let mut l0 = 0;
-        #[cfg(target_arch = "x86_64")]
-        if V {
-            for l in (0..m).step_by(LANES) {
-                let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
-                // SAFETY: as for gather8 above (the same lanes); write_back8 checks the slots.
-                unsafe { write_back8(self, l, valid, shear, base) };
-            }
-            l0 = m;
-        }
-        for l in l0..m {
-            shear[self.k[l] as usize - base] = [self.s[0][l], self.s[1][l], self.s[2][l]];
-        }
-        (max_delta, max_excess)
     }
+    let audit = FR && inp.audit;
+    if audit {
+        lanes::<FR, true>(b, inp.law, 2.0 * inp.r, inp.h);
+    } else {
+        lanes::<FR, false>(b, inp.law, 2.0 * inp.r, inp.h);
+    }
+    let max_delta = lane_max(m, 0.0f32, |l| b.delta[l]) as f64;
+    if !FR {
+        return (max_delta, f64::NEG_INFINITY);
+    }
+    let max_excess = if audit { lane_max(m, f32::NEG_INFINITY, |l| b.excess[l]) as f64 } else { f64::NEG_INFINITY };
+    let mut l0 = 0;
+    #[cfg(target_arch = "x86_64")]
+    if let Some(isa) = isa.as_avx512() {
+        for l in (0..m).step_by(LANES) {
+            let valid = if m - l >= LANES { 0xff } else { (1u8 << (m - l)) - 1 };
+            write_back8(isa, b, l, valid, shear, base);
+        }
+        l0 = m;
+    }
+    for l in l0..m {
+        shear[b.k[l] as usize - base] = [b.s[0][l], b.s[1][l], b.s[2][l]];
+    }
+    (max_delta, max_excess)
 }
 
 /// max(start, value(0), …, value(n − 1)) with eight independent partial maxima (a vector max,
@@ -178,12 +100,6 @@ fn lane_max<T: Copy + PartialOrd>(n: usize, start: T, value: impl Fn(usize) -> T
         part[0] = if x > part[0] { x } else { part[0] };
     }
     part.iter().fold(start, |a, &b| if b > a { b } else { a })
-}
-
-impl Default for Box<Batch> {
-    fn default() -> Self {
-        Batch::new()
-    }
 }
 
 /// The contact law over lanes 0..m, no branches (the operations of `contact_force`), in single

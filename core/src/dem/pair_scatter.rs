@@ -9,22 +9,24 @@
 //! law's); rounding the running sum adds at most (k − 1)·2⁻²⁴·Σ|F| for k terms (test
 //! `chunk_sums_within_the_rounding_bound_of_the_exact_sums`), the order of the law's own error.
 
-use super::pair_batch::{Batch, CAP};
+use super::batch::{Batch, CAP};
+use super::kernel::Isa;
 
 /// Force (0..3) and n × F_t (3..6) sums of one particle over one chunk's pairs; 6 and 7 are zero.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(32))]
-pub struct PairSum(pub [f32; 8]);
+pub(crate) struct PairSum(pub [f32; 8]);
 
 /// Add lanes 0..batch.m into `acc` (indices as the lanes'), lane by lane, i before j.
+/// Panics unless every lane's particles index `acc`.
 #[inline(always)]
-pub fn scatter<const FR: bool, const V: bool>(b: &Batch, acc: &mut [PairSum]) {
+pub(crate) fn scatter<const FR: bool, const V: bool>(isa: Isa<V>, b: &Batch, acc: &mut [PairSum]) {
     let m = b.m.min(CAP);
     #[cfg(target_arch = "x86_64")]
-    if V {
+    if let Some(_proof) = isa.as_avx512() {
         for l in (0..m).step_by(8) {
-            // SAFETY: V is set only by the caller compiled for (and checked to have) the
-            // features; l + 8 ≤ CAP; scatter8 checks the particle indices.
+            // SAFETY: `_proof` shows the CPU has the features; l + 8 ≤ CAP (CAP is a multiple
+            // of 8); scatter8 checks the particle indices.
             unsafe { scatter8::<FR>(b, l, (m - l).min(8), acc) };
         }
         return;

@@ -13,46 +13,64 @@
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
 
+use super::batch::{Batch, Entries, PairInputs, CAP};
 use super::contact::V3;
+use super::kernel::Isa;
 use super::neighbors::Hist;
-use super::pair_batch::{Batch, CAP};
 
 /// Lanes this step can add to a batch: a batch with more than `CAP - LANES` filled is flushed
 /// first.
-pub const LANES: usize = 8;
+pub(crate) const LANES: usize = 8;
 
-/// Entries k..k+8 (rows `owner`, partners `nbr`, flags `to[k - base..]` when FR) into `batch`
-/// from lane m (≤ CAP − 8), with particle indices relative to the window `x` = particles
-/// `first`..; returns the new lane count.
-///
-/// # Safety
-/// The CPU has avx512f, avx512vl and bmi2; k + 8 ≤ owner.len() = nbr.len(); every owner and
-/// partner index − first is in 0..x.len(), x.len() ≤ i32::MAX / 3; k − base + 8 ≤ to.len()
-/// when FR; m ≤ CAP − 8.
+/// Entries k..k+8 of `e` (flags `to[k - base..]` when FR) into `batch` from lane m (≤ CAP − 8);
+/// returns the new lane count. Panics unless the entries, flags and lanes exist and every row
+/// and partner index − `e.first` is in 0..e.x.len().
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,bmi2")]
-#[allow(clippy::too_many_arguments)]
-pub unsafe fn scan8<const FR: bool>(
+#[inline(always)]
+pub(crate) fn scan8<const FR: bool>(
+    isa: Isa<true>,
+    e: &Entries,
     k: usize,
     base: usize,
-    first: usize,
-    owner: &[u32],
-    nbr: &[u32],
-    x: &[V3],
-    d2: f64,
     to: &mut [u8],
     batch: &mut Batch,
     m: usize,
 ) -> usize {
+    let _proof = isa;
+    assert!(k + LANES <= e.owner.len() && k + LANES <= e.nbr.len() && m <= CAP - LANES, "entries or lanes");
+    assert!(e.x.len() <= i32::MAX as usize / 3 && e.first <= u32::MAX as usize, "window size");
+    assert!(!FR || (k >= base && k - base + LANES <= to.len()), "contact flags");
+    // SAFETY: `isa` proves the CPU features; the bounds are checked above, the indices inside.
+    unsafe { scan8_avx512::<FR>(e, k, base, to, batch, m) }
+}
+
+/// # Safety
+/// The CPU has avx512f, avx512vl and bmi2; the bounds `scan8` checks hold.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,bmi2")]
+unsafe fn scan8_avx512<const FR: bool>(
+    e: &Entries,
+    k: usize,
+    base: usize,
+    to: &mut [u8],
+    batch: &mut Batch,
+    m: usize,
+) -> usize {
+    let &Entries { owner, nbr, first, x, d2 } = e;
     debug_assert!(k + LANES <= owner.len() && k + LANES <= nbr.len() && m <= CAP - LANES);
-    let at = _mm256_set1_epi32(first as i32);
+    let at = _mm256_set1_epi32(first as u32 as i32);
     let oi = _mm256_sub_epi32(_mm256_loadu_si256(owner.as_ptr().add(k) as *const __m256i), at);
     let oj = _mm256_sub_epi32(_mm256_loadu_si256(nbr.as_ptr().add(k) as *const __m256i), at);
+    // Indices below first wrap to large unsigned values, so one compare checks both ends.
+    let len = _mm256_set1_epi32(x.len() as i32);
+    let inside = _mm256_cmplt_epu32_mask(oi, len) & _mm256_cmplt_epu32_mask(oj, len);
+    assert!(inside == 0xff, "pair index outside the chunk window");
     // f64 offsets of x[i][0]: 3 i.
     let (ti, tj) = (_mm256_add_epi32(_mm256_add_epi32(oi, oi), oi), _mm256_add_epi32(_mm256_add_epi32(oj, oj), oj));
     let p = x.as_ptr() as *const f64;
     // The rows of eight consecutive entries are ascending (the list's order).
-    let (i0, i7) = (*owner.get_unchecked(k) as usize - first, *owner.get_unchecked(k + 7) as usize - first);
+    let rel = |o: u32| o.wrapping_sub(first as u32) as usize; // the lanes' values, checked above
+    let (i0, i7) = (rel(owner[k]), rel(owner[k + 7]));
     let rows = Rows::new(p, i0, i7, x.len(), ti, 0xff);
     let mut dx = [_mm512_setzero_pd(); 3];
     for (a, d) in dx.iter_mut().enumerate() {
@@ -94,16 +112,33 @@ pub unsafe fn scan8<const FR: bool>(
 }
 
 /// Lanes l..l+8 of `batch` (those in `valid`): v_i − v_j, R(ω_i + ω_j) and, for lanes whose
-/// history is live, the history `shear[k − base]` (zero otherwise). Panics unless every valid
-/// lane has i, j < v.len() (and w.len() when FR) and base ≤ k < base + shear.len().
-///
+/// history is live, the history `shear[k − base]` (zero otherwise). Panics unless l + 8 ≤ CAP and
+/// every valid lane has i, j < v.len() (and w.len() when FR) and base ≤ k < base + shear.len().
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn gather8<const FR: bool>(
+    isa: Isa<true>,
+    batch: &mut Batch,
+    l: usize,
+    valid: __mmask8,
+    inp: &PairInputs,
+    shear: &[Hist],
+    base: usize,
+) {
+    let _proof = isa;
+    assert!(l + LANES <= CAP, "lanes");
+    let limit = i32::MAX as usize / 3;
+    assert!(inp.v.len() <= limit && inp.w.len() <= limit && shear.len() <= limit && base <= u32::MAX as usize);
+    // SAFETY: `isa` proves the CPU features; the sizes are checked above, the indices inside.
+    unsafe { gather8_avx512::<FR>(batch, l, valid, inp.r, inp.v, inp.w, shear, base) }
+}
+
 /// # Safety
-/// The CPU has avx512f, avx512vl and bmi2; l + 8 ≤ CAP; v.len(), w.len() and shear.len() are
-/// at most i32::MAX / 3.
+/// The CPU has avx512f, avx512vl and bmi2; the bounds `gather8` checks hold.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,bmi2")]
-#[allow(clippy::too_many_arguments)]
-pub unsafe fn gather8<const FR: bool>(
+#[allow(clippy::too_many_arguments)] // `gather8`'s, unpacked for the intrinsics
+unsafe fn gather8_avx512<const FR: bool>(
     batch: &mut Batch,
     l: usize,
     valid: __mmask8,
@@ -125,7 +160,7 @@ pub unsafe fn gather8<const FR: bool>(
     let vp = v.as_ptr() as *const f64;
     // Lanes keep the entries' order, so rows and slots ascend from the first to the last valid lane.
     let last = l + 7 - valid.leading_zeros() as usize;
-    let (i0, il) = (*batch.i.get_unchecked(l) as usize, *batch.i.get_unchecked(last) as usize);
+    let (i0, il) = (batch.i[l] as usize, batch.i[last] as usize);
     let vrows = Rows::new(vp, i0, il, v.len(), ti, valid);
     for q in 0..3 {
         let vi = vrows.component(q);
@@ -136,15 +171,18 @@ pub unsafe fn gather8<const FR: bool>(
         return;
     }
     let (wp, sp, rr) = (w.as_ptr() as *const f64, shear.as_ptr() as *const f32, _mm512_set1_pd(r));
-    let kk =
-        _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let kk = _mm256_sub_epi32(
+        _mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i),
+        _mm256_set1_epi32(base as u32 as i32),
+    );
     // k < base wraps to a large unsigned value, so one compare checks both ends.
     assert!(below(kk, shear.len()) & valid == valid, "history slot beyond the chunk");
     let tk = three(kk);
     const BYTES: u64 = 0x0101_0101_0101_0101;
     let live = valid & _pext_u64((batch.was.as_ptr().add(l) as *const u64).read_unaligned(), BYTES) as __mmask8;
     let wrows = Rows::new(wp, i0, il, w.len(), ti, valid);
-    let (k0, kl) = (*batch.k.get_unchecked(l) as usize - base, *batch.k.get_unchecked(last) as usize - base);
+    let slot = |k: u32| k.wrapping_sub(base as u32) as usize; // the lanes' values, checked above
+    let (k0, kl) = (slot(batch.k[l]), slot(batch.k[last]));
     let slots = Slots::new(sp, k0, kl, shear.len(), tk, live);
     for q in 0..3 {
         let wi = wrows.component(q);
@@ -156,16 +194,26 @@ pub unsafe fn gather8<const FR: bool>(
 
 /// The histories of lanes l..l+8 (those in `valid`) back into `shear[k − base]`, by three
 /// vector scatters (the slots are distinct; the values are exact in single precision). Panics
-/// unless every valid lane has base ≤ k < base + shear.len().
-///
-/// # Safety
-/// The CPU has avx512f and avx512vl; l + 8 ≤ CAP; shear.len() ≤ i32::MAX / 3.
+/// unless l + 8 ≤ CAP and every valid lane has base ≤ k < base + shear.len().
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-pub unsafe fn write_back8(batch: &Batch, l: usize, valid: __mmask8, shear: &mut [Hist], base: usize) {
+pub(crate) fn write_back8(isa: Isa<true>, batch: &Batch, l: usize, valid: __mmask8, shear: &mut [Hist], base: usize) {
+    let _proof = isa;
+    assert!(l + LANES <= CAP && shear.len() <= i32::MAX as usize / 3 && base <= u32::MAX as usize);
+    // SAFETY: `isa` proves the CPU features; the sizes are checked above, the slots inside.
+    unsafe { write_back8_avx512(batch, l, valid, shear, base) }
+}
+
+/// # Safety
+/// The CPU has avx512f and avx512vl; the bounds `write_back8` checks hold.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn write_back8_avx512(batch: &Batch, l: usize, valid: __mmask8, shear: &mut [Hist], base: usize) {
     debug_assert!(l + LANES <= CAP);
-    let kk =
-        _mm256_sub_epi32(_mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i), _mm256_set1_epi32(base as i32));
+    let kk = _mm256_sub_epi32(
+        _mm256_loadu_si256(batch.k.as_ptr().add(l) as *const __m256i),
+        _mm256_set1_epi32(base as u32 as i32),
+    );
     let inside = _mm256_cmplt_epu32_mask(kk, _mm256_set1_epi32(shear.len() as i32));
     assert!(inside & valid == valid, "history slot beyond the chunk");
     let tk = _mm256_add_epi32(_mm256_add_epi32(kk, kk), kk);
@@ -282,8 +330,8 @@ mod tests {
     /// four-load and gather paths), lanes near both ends of the array and partial masks.
     #[test]
     fn rows_and_slots_by_permute_equal_the_gather() {
-        if !(is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")) {
-            return;
+        if Isa::avx512().is_none() {
+            return crate::dem::tests::skip("rows_and_slots_by_permute_equal_the_gather", "no AVX-512");
         }
         let len = 40;
         let data: Vec<[f64; 3]> = (0..len).map(|i| [i as f64, 1000.0 + i as f64, -(i as f64) - 0.5]).collect();

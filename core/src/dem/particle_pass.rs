@@ -6,6 +6,7 @@
 use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::{dist2, V3};
 use super::forces::{Acc, Past, Stats};
+use super::kernel::{Isa, Kernel};
 use super::walls::{wall_forces, WallList};
 use super::work_split::Sums;
 use super::DemParams;
@@ -13,7 +14,7 @@ use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// Particles per block of the particle pass.
-pub const BLOCK: usize = 256;
+pub(crate) const BLOCK: usize = 256;
 
 /// `out` with every row written (the block's stack rows need no clearing pass first, which
 /// cost ~1% of a step).
@@ -28,22 +29,18 @@ fn written<T: Copy>(out: &mut [MaybeUninit<T>], mut row: impl FnMut(usize) -> T)
 
 /// Force and n × F_t sums of the particles lo..lo + out.len() (`x`, `v`, `w`: their slices):
 /// the external force (none when `ext` is empty), then the chunk buffers in chunk order, then
-/// walls for the wall-list entries `widx`/`whist`.
-#[allow(clippy::too_many_arguments)]
+/// walls for the wall-list entries `widx`/`whist`; and the largest overlap and Coulomb excess.
 #[inline(always)]
 fn block_forces<'o, const FR: bool>(
     p: &DemParams,
     lo: usize,
-    x: &[V3],
-    v: &[V3],
-    w: &[V3],
+    (x, v, w): (&[V3], &[V3], &[V3]),
     ext: &[V3],
     sc: Sums,
-    widx: &[u32],
-    whist: &mut [[V3; 3]],
+    (widx, whist): (&[u32], &mut [[V3; 3]]),
     out: &'o mut [MaybeUninit<Acc>],
-    st: &mut Stats,
-) -> &'o mut [Acc] {
+) -> (&'o mut [Acc], Stats) {
+    let mut st = Stats::ZERO;
     let hi = lo + out.len();
     // A scene without gas skips the stream of zeros (1–5% of a step, docs/BENCHMARKS.md).
     let out = if ext.is_empty() {
@@ -69,7 +66,7 @@ fn block_forces<'o, const FR: bool>(
         st.overlap = st.overlap.max(ov);
         st.coulomb_excess = st.coulomb_excess.max(ex);
     }
-    out
+    (out, st)
 }
 
 /// a = F/m − g e_z − γ v of a particle with sums `o` and velocity `vi` (gravity and the pour's
@@ -111,12 +108,9 @@ fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> 
 }
 
 /// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
-#[allow(clippy::too_many_arguments)]
-pub fn accel_pass<const FR: bool>(
+pub(crate) fn accel_pass<const FR: bool>(
     p: &DemParams,
-    x: &[V3],
-    v: &[V3],
-    w: &[V3],
+    (x, v, w): (&[V3], &[V3], &[V3]),
     walls: &mut WallList,
     ext: &[V3],
     sc: Sums,
@@ -127,12 +121,12 @@ pub fn accel_pass<const FR: bool>(
         .zip(wb)
         .enumerate()
         .map(|(b, (ob, (widx, whist)))| {
-            let mut st = Stats::ZERO;
             let r = b * BLOCK..b * BLOCK + ob.len();
             let (v, w) = (&v[r.clone()], &w[r.clone()]);
-            // SAFETY: initialised rows seen as possibly uninitialised; block_forces writes them all.
+            // SAFETY: initialised rows seen as possibly uninitialised; block_forces writes them all
+            // (with initialised values only).
             let rows = unsafe { &mut *(ob as *mut [Acc] as *mut [MaybeUninit<Acc>]) };
-            let ob = block_forces::<FR>(p, r.start, &x[r], v, w, ext, sc, widx, whist, rows, &mut st);
+            let (ob, st) = block_forces::<FR>(p, r.start, (&x[r], v, w), ext, sc, (widx, whist), rows);
             for ((o, &vi), &wi) in ob.iter_mut().zip(v).zip(w) {
                 let (a, alpha) = (accel_of(p, o, vi), alpha_of::<FR>(p, o, wi));
                 *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
@@ -142,8 +136,16 @@ pub fn accel_pass<const FR: bool>(
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
+/// The multistep update of a step: weights hb = h·b (PHYSICS.md 7), and the slot `ring` of the
+/// past derivatives that holds the newer values (the current ones overwrite the other).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Weights {
+    pub hb: [f64; 3],
+    pub ring: usize,
+}
+
 /// Mutable per-particle state of the particle pass.
-pub struct Motion<'a> {
+pub(crate) struct Motion<'a> {
     pub x: &'a mut [V3],
     pub v: &'a mut [V3],
     pub w: &'a mut [V3],
@@ -166,11 +168,18 @@ pub(super) struct BlockMotion<'a> {
     pub whist: &'a mut [[V3; 3]],
 }
 
-/// Pass 2, fused: accelerations and the multistep update (weights `hb` = h·b; slot `ring` of
-/// `past` holds the newer values, the current derivative overwrites the other) in one sweep.
-pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: Motion, ext: &[V3], sc: Sums) -> Stats {
+/// Pass 2, fused: accelerations and the multistep update (`step`) in one sweep, on the `kernel`
+/// path.
+pub(crate) fn update_pass<const FR: bool>(
+    kernel: Kernel,
+    p: &DemParams,
+    step: Weights,
+    m: Motion,
+    ext: &[V3],
+    sc: Sums,
+) -> Stats {
     let n = m.x.len();
-    let older = 1 - ring;
+    let older = 1 - step.ring;
     let mut wb = wall_blocks(m.walls, n).into_iter();
     let [pv, pa, pw] = [&mut m.past.v, &mut m.past.a, &mut m.past.alpha].map(|s| {
         let (s0, s1) = s.split_at_mut(1);
@@ -194,72 +203,87 @@ pub fn update_pass<const FR: bool>(p: &DemParams, hb: [f64; 3], ring: usize, m: 
     }
     let x_ref = m.x_ref;
     work.into_par_iter()
-        .map(|bm| update_block_dispatch::<FR>(p, hb, bm, x_ref, ext, sc))
+        .map(|bm| update_block_on::<FR>(kernel, p, step, bm, x_ref, ext, sc))
         .reduce(|| Stats::ZERO, Stats::max)
 }
 
-pub(super) fn update_block_dispatch<const FR: bool>(
+/// One block of the fused particle pass on the `kernel` path (the portable one when the CPU
+/// lacks it).
+pub(crate) fn update_block_on<const FR: bool>(
+    kernel: Kernel,
     p: &DemParams,
-    hb: [f64; 3],
-    bm: BlockMotion,
-    xb: &[V3],
-    ext: &[V3],
-    sc: Sums,
-) -> Stats {
-    #[cfg(target_arch = "x86_64")]
-    {
-        if std::arch::is_x86_feature_detected!("avx512f") {
-            // SAFETY: the CPU supports the features the function is compiled for.
-            return unsafe { update_block_avx512::<FR>(p, hb, bm, xb, ext, sc) };
-        }
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: as above.
-            return unsafe { update_block_avx2::<FR>(p, hb, bm, xb, ext, sc) };
-        }
-    }
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn update_block_avx512<const FR: bool>(
-    p: &DemParams,
-    hb: [f64; 3],
-    bm: BlockMotion,
-    xb: &[V3],
-    ext: &[V3],
-    sc: Sums,
-) -> Stats {
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn update_block_avx2<const FR: bool>(
-    p: &DemParams,
-    hb: [f64; 3],
-    bm: BlockMotion,
-    xb: &[V3],
-    ext: &[V3],
-    sc: Sums,
-) -> Stats {
-    update_block::<FR>(p, hb, bm, xb, ext, sc)
-}
-
-#[inline(always)]
-fn update_block<const FR: bool>(
-    p: &DemParams,
-    hb: [f64; 3],
+    step: Weights,
     bm: BlockMotion,
     x_ref: &[V3],
     ext: &[V3],
     sc: Sums,
 ) -> Stats {
+    #[cfg(target_arch = "x86_64")]
+    match kernel {
+        Kernel::Avx512 => {
+            if let Some(isa) = Isa::avx512() {
+                // SAFETY: `isa` proves the features the function is compiled for.
+                return unsafe { update_block_avx512::<FR>(isa, p, step, bm, (x_ref, ext), sc) };
+            }
+        }
+        Kernel::Avx2 => {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has the feature the function is compiled for.
+                return unsafe { update_block_avx2::<FR>(p, step, bm, (x_ref, ext), sc) };
+            }
+        }
+        Kernel::Portable => {}
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = kernel;
+    update_block::<FR, false>(Isa::PORTABLE, p, step, bm, (x_ref, ext), sc)
+}
+
+/// # Safety
+/// The CPU has avx512f, avx512vl and bmi2 (which `isa` proves).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,bmi2")]
+unsafe fn update_block_avx512<const FR: bool>(
+    isa: Isa<true>,
+    p: &DemParams,
+    step: Weights,
+    bm: BlockMotion,
+    refs: (&[V3], &[V3]),
+    sc: Sums,
+) -> Stats {
+    update_block::<FR, true>(isa, p, step, bm, refs, sc)
+}
+
+/// # Safety
+/// The CPU has avx2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn update_block_avx2<const FR: bool>(
+    p: &DemParams,
+    step: Weights,
+    bm: BlockMotion,
+    refs: (&[V3], &[V3]),
+    sc: Sums,
+) -> Stats {
+    update_block::<FR, false>(Isa::PORTABLE, p, step, bm, refs, sc)
+}
+
+/// Block `bm`: forces, accelerations, the multistep update, and (unless `x_ref` is empty) the
+/// largest squared displacement since `x_ref`.
+#[inline(always)]
+fn update_block<const FR: bool, const V: bool>(
+    isa: Isa<V>,
+    p: &DemParams,
+    Weights { hb, .. }: Weights,
+    bm: BlockMotion,
+    (x_ref, ext): (&[V3], &[V3]),
+    sc: Sums,
+) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
     let len = x.len();
-    let mut st = Stats::ZERO;
+    assert!(len <= BLOCK && v.len() == len && w.len() == len, "block size");
     let mut rows = [MaybeUninit::<Acc>::uninit(); BLOCK];
-    let acc = block_forces::<FR>(p, lo, x, v, w, ext, sc, widx, whist, &mut rows[..len], &mut st);
+    let (acc, mut st) = block_forces::<FR>(p, lo, (x, v, w), ext, sc, (widx, whist), &mut rows[..len]);
     // Accelerations straight into the flat arrays the update reads.
     let (mut a, mut al) = ([MaybeUninit::<V3>::uninit(); BLOCK], [MaybeUninit::<V3>::uninit(); BLOCK]);
     let a = written(&mut a[..len], |l| accel_of(p, &acc[l], v[l]));
@@ -268,7 +292,7 @@ fn update_block<const FR: bool>(
     // x first: it uses the old velocities.
     let vel: &[f64] = v.as_flattened();
     (st.moved, st.extent) =
-        ab_flat_moved(hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
+        ab_flat_moved(isa, hb, x.as_flattened_mut(), vel, newer[0].as_flattened(), ov.as_flattened_mut());
     ab_flat(hb, v.as_flattened_mut(), a.as_flattened(), newer[1].as_flattened(), oa.as_flattened_mut());
     if FR {
         ab_flat(hb, w.as_flattened_mut(), al.as_flattened(), newer[2].as_flattened(), ow.as_flattened_mut());

@@ -5,12 +5,14 @@
 //! re-sort first if the list could miss a near pair.
 
 use super::contact::{dist2, V3};
-use super::forces::{pair_pass, Acc, Kernels, Past, Scratch, Stats};
+use super::forces::{pair_pass, Acc, Past, Scratch, Stats};
 use super::integrator::weights;
+use super::kernel::Kernel;
 use super::near_list::{Histories, NearList};
 use super::neighbors::{build_list, cell_order, NeighborList};
-use super::particle_pass::{accel_pass, update_pass, Motion};
-use super::team_step::{team_step, StepState, TeamLock};
+use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
+use super::team_lock::TeamLock;
+use super::team_step::{team_step, StepState};
 use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
@@ -69,6 +71,9 @@ pub struct DemSystem {
     /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
     #[serde(skip)]
     sc: Scratch,
+    /// The code path of the passes (`FLUIDBED_KERNEL`, else the best the CPU has).
+    #[serde(skip, default = "Kernel::from_env")]
+    kernel: Kernel,
 }
 
 impl DemSystem {
@@ -108,6 +113,7 @@ impl DemSystem {
             sc_threads: 0,
             neighbour_s: 0.0,
             sc: Scratch::default(),
+            kernel: Kernel::from_env(),
         };
         s.rebuild();
         s
@@ -176,6 +182,18 @@ impl DemSystem {
     /// kept then). For diagnostics.
     pub fn touching_pairs(&self) -> Option<usize> {
         self.p.friction.then(|| self.near.list.touch.iter().filter(|&&t| t != 0).count())
+    }
+    /// The code path the passes run (the same bits on every path).
+    pub fn kernel(&self) -> Kernel {
+        self.kernel
+    }
+    /// Run the passes on `kernel` from the next step on; an error if this CPU lacks it.
+    pub fn set_kernel(&mut self, kernel: Kernel) -> Result<(), String> {
+        if !kernel.is_available() {
+            return Err(format!("this CPU lacks the {kernel} kernel path"));
+        }
+        self.kernel = kernel;
+        Ok(())
     }
     pub fn is_frozen(&self) -> bool {
         self.frozen
@@ -285,14 +303,14 @@ impl DemSystem {
         let x_ref = if exact { &self.x_near[..] } else { &[] };
         let st = if self.levels == 0 {
             let st1 =
-                pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+                pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
             let st = st1.max(self.heun::<FR>());
             self.sc.bounds.clear(); // replanned at the next step, now with the contacts' flags
             st
         } else {
             let h = self.p.dt;
             let b = weights(self.levels);
-            let hb = [h * b[0], h * b[1], h * b[2]];
+            let step = Weights { hb: [h * b[0], h * b[1], h * b[2]], ring: self.ring as usize };
             let st = match team {
                 Some(_) => {
                     let s = StepState {
@@ -305,19 +323,12 @@ impl DemSystem {
                         sc: &mut self.sc,
                     };
                     self.team_steps += 1;
-                    team_step::<FR>(&self.p, hb, self.ring as usize, s, x_ref, &self.ext)
+                    team_step::<FR>(self.kernel, &self.p, step, s, x_ref, &self.ext)
                 }
                 // Two parallel loops, which cannot wait on another team's threads.
                 None => {
-                    let st1 = pair_pass::<FR>(
-                        &self.p,
-                        &self.x,
-                        &self.v,
-                        &self.w,
-                        &mut self.near.list,
-                        &mut self.sc,
-                        Kernels::Best,
-                    );
+                    let state = (&self.x[..], &self.v[..], &self.w[..]);
+                    let st1 = pair_pass::<FR>(&self.p, state, &mut self.near.list, &mut self.sc, self.kernel);
                     let m = Motion {
                         x: &mut self.x,
                         v: &mut self.v,
@@ -326,7 +337,7 @@ impl DemSystem {
                         x_ref,
                         walls: &mut self.walls,
                     };
-                    st1.max(update_pass::<FR>(&self.p, hb, self.ring as usize, m, &self.ext, self.sc.sums()))
+                    st1.max(update_pass::<FR>(self.kernel, &self.p, step, m, &self.ext, self.sc.sums()))
                 }
             };
             self.ring = 1 - self.ring;
@@ -406,7 +417,7 @@ impl DemSystem {
         let h = self.p.dt;
         let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
         let st =
-            accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
+            accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
         let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
         let nl = &self.near.list;
         let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
@@ -416,9 +427,9 @@ impl DemSystem {
             self.v[i] = step(&v0[i], &d0[i][..3], h);
             self.w[i] = step(&w0[i], &d0[i][3..], h);
         }
-        pair_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.near.list, &mut self.sc, Kernels::Best);
+        pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
         let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
-        accel_pass::<FR>(&self.p, &self.x, &self.v, &self.w, &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
+        accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
         (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
         let newer = 1 - self.ring as usize;
         for i in 0..n {

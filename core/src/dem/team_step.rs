@@ -9,17 +9,18 @@
 //! buffers and blocks, whichever thread takes them), so every bit of the result is the same.
 
 use super::contact::V3;
-use super::forces::{chunk_pairs_dispatch, ChunkArgs, Past, Scratch, Stats};
+use super::forces::{chunk_pairs_on, ChunkArgs, Past, Scratch, Stats};
+use super::kernel::Kernel;
 use super::neighbors::{Hist, NeighborList};
 use super::pair_scatter::PairSum;
-use super::particle_pass::{block_walls, update_block_dispatch, BlockMotion, BLOCK};
+use super::particle_pass::{block_walls, update_block_on, BlockMotion, Weights, BLOCK};
 use super::steal_ranges::StealRanges;
+#[cfg(test)]
+use super::team_lock::has_own_team;
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
-use std::cell::RefCell;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 
 /// Spins (then yields) until every chunk c with `need(c)` is done; false if a chunk failed
 /// (its thread panicked), so that nobody waits for it for ever.
@@ -75,54 +76,8 @@ impl<T> Raw<T> {
 #[cfg(test)]
 pub(crate) static PANIC_IN_CHUNK: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
-/// At most one team at a time per pool: a team's threads spin while they wait, so two teams
-/// sharing a pool could each wait for a thread the other holds. Pools built by
-/// `pool_with_own_team` have a lock each; every other pool (and code outside any pool) shares
-/// one process-wide lock. Whoever does not get the lock steps with plain parallel loops. Neither
-/// `Send` nor `Sync`, so the holder cannot hand it to the tasks of a parallel loop (which would
-/// start two teams on one pool).
-pub struct TeamLock {
-    flag: Option<Arc<AtomicBool>>,
-    not_send: std::marker::PhantomData<*const ()>,
-}
-
-static TEAM_BUSY: AtomicBool = AtomicBool::new(false);
-
-thread_local! {
-    /// The team flag of the pool this thread works for, if it was built by `pool_with_own_team`.
-    static POOL_TEAM: RefCell<Option<Arc<AtomicBool>>> = const { RefCell::new(None) };
-}
-
-/// A pool builder whose pool gets its own team lock, so that systems stepped on different such
-/// pools at once (the server's concurrent jobs) each run as a team.
-pub fn pool_with_own_team() -> rayon::ThreadPoolBuilder {
-    let flag = Arc::new(AtomicBool::new(false));
-    rayon::ThreadPoolBuilder::new().start_handler(move |_| POOL_TEAM.with(|p| *p.borrow_mut() = Some(flag.clone())))
-}
-
-#[cfg(test)]
-fn has_own_team() -> bool {
-    POOL_TEAM.with(|p| p.borrow().is_some())
-}
-
-impl TeamLock {
-    /// The lock of the current thread's pool (the pool a broadcast from here runs on).
-    pub fn try_take() -> Option<TeamLock> {
-        let flag = POOL_TEAM.with(|p| p.borrow().clone());
-        let busy = flag.as_deref().unwrap_or(&TEAM_BUSY);
-        busy.compare_exchange(false, true, Ordering::Acquire, Ordering::Relaxed).ok()?;
-        Some(TeamLock { flag, not_send: std::marker::PhantomData })
-    }
-}
-
-impl Drop for TeamLock {
-    fn drop(&mut self) {
-        self.flag.as_deref().unwrap_or(&TEAM_BUSY).store(false, Ordering::Release);
-    }
-}
-
 /// The state the steps change.
-pub struct StepState<'a> {
+pub(crate) struct StepState<'a> {
     pub x: &'a mut [V3],
     pub v: &'a mut [V3],
     pub w: &'a mut [V3],
@@ -132,12 +87,14 @@ pub struct StepState<'a> {
     pub sc: &'a mut Scratch,
 }
 
-/// The pair pass and the fused particle pass of one step: weights `hb` (= h·b), newer past
-/// slot `ring`, displacements measured from `x_ref` (unless it is empty).
-pub fn team_step<const FR: bool>(
+/// The pair pass and the fused particle pass of one step (`step`: the multistep weights and
+/// slot), displacements measured from `x_ref` (unless it is empty), on the `kernel` path. The
+/// caller holds the pool's `TeamLock`. Panics unless the state has one row per particle and `sc`
+/// was planned for `s.nl` (chunks in order, their list entries and buffers disjoint).
+pub(crate) fn team_step<const FR: bool>(
+    kernel: Kernel,
     p: &DemParams,
-    hb: [f64; 3],
-    ring: usize,
+    step: Weights,
     s: StepState,
     x_ref: &[V3],
     ext: &[V3],
@@ -150,7 +107,12 @@ pub fn team_step<const FR: bool>(
     assert!(past.v.iter().chain(&past.a).chain(&past.alpha).all(|s| s.len() == n), "past derivatives");
     let (offsets, nbr) = (&nl.offsets[..], &nl.nbr[..]);
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
-    assert!(start.len() > bounds.len() && bounds.iter().all(|&[a, b, e]| a <= b && b <= e && e <= n));
+    assert!(start.len() > bounds.len() && bounds.iter().all(|&[a, b, e]| a <= b && b <= e && e <= n), "chunks");
+    // What the threads write must be disjoint: chunk c writes list entries offsets[a]..offsets[b]
+    // and buffer rows start[c]..start[c] + e − a, so the chunks must follow each other.
+    assert!(offsets.len() == n + 1 && offsets.windows(2).all(|o| o[0] <= o[1]), "list offsets");
+    assert!(bounds.windows(2).all(|c| c[0][1] == c[1][0]), "chunks in order");
+    assert!(bounds.iter().enumerate().all(|(c, &[a, _, e])| start[c] + e - a <= start[c + 1]), "chunk buffers");
     let (nc, nb) = (bounds.len(), n.div_ceil(BLOCK));
     let widx = &walls.idx[..];
     let raw = Shared {
@@ -169,7 +131,6 @@ pub fn team_step<const FR: bool>(
     let (chunk_queue, block_queue) = (StealRanges::new(nc, team, true), StealRanges::new(nb, team, false));
     let done: Vec<AtomicBool> = (0..nc).map(|_| AtomicBool::new(false)).collect();
     let failed = AtomicBool::new(false);
-    let (r, d2) = (p.radius, 4.0 * p.radius * p.radius);
     let per_thread = rayon::broadcast(|ctx| {
         let (t, nt) = (ctx.index(), ctx.num_threads());
         assert!(nt == team, "broadcast on the pool that was counted");
@@ -185,14 +146,13 @@ pub fn team_step<const FR: bool>(
                 let (k0, k1) = if FR { (offsets[a] as usize, offsets[b] as usize) } else { (0, 0) };
                 let (sh, to) = unsafe { (raw.shear.part(k0, k1), raw.touch.part(k0, k1)) };
                 let buf = unsafe { raw.acc.part(start[c], start[c] + e - a) };
-                let args =
-                    ChunkArgs { law: &p.pair, audit: p.audit, r, h: p.dt, d2, a, b, offsets, nbr, owner, x, v, w };
+                let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (x, v, w));
                 #[cfg(test)]
                 assert!(
                     PANIC_IN_CHUNK.load(Ordering::Relaxed) != c + 1 || has_own_team(),
                     "injected panic in chunk {c}"
                 );
-                st = st.max(chunk_pairs_dispatch::<FR>(&args, sh, to, buf));
+                st = st.max(chunk_pairs_on::<FR>(kernel, &args, sh, to, buf));
                 done[c].store(true, Ordering::Release);
             }
         }));
@@ -203,7 +163,7 @@ pub fn team_step<const FR: bool>(
         // SAFETY: rows are read through `sums` only for a block whose chunks are done (below);
         // the other chunks' buffer rows are not read.
         let sums = unsafe { Sums::from_raw(bounds, start, raw.acc.ptr, raw.acc.len) };
-        let older = 1 - ring;
+        let (ring, older) = (step.ring, 1 - step.ring);
         while let Some(b) = block_queue.take(t) {
             let (lo, hi, wr) = (b * BLOCK, ((b + 1) * BLOCK).min(n), block_walls(widx, b, n));
             // Block b's particles lie in the windows of the chunks that overlap it.
@@ -223,7 +183,7 @@ pub fn team_step<const FR: bool>(
                 whist: unsafe { raw.whist.part(wr.start, wr.end) },
                 widx: &widx[wr],
             };
-            st = st.max(update_block_dispatch::<FR>(p, hb, bm, x_ref, ext, sums));
+            st = st.max(update_block_on::<FR>(kernel, p, step, bm, x_ref, ext, sums));
         }
         st
     });

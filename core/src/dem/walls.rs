@@ -4,7 +4,7 @@
 //! skin of a wall at the last rebuild (a rebuild comes before anything moves half a skin), with
 //! the tangential histories of its three walls.
 
-use super::contact::{contact_force, ContactLaw, V3};
+use super::contact::{contact_force, V3};
 use super::DemParams;
 use serde::{Deserialize, Serialize};
 
@@ -43,27 +43,18 @@ impl WallList {
         }
         out
     }
-
-    /// Entries [k0, k1) of the list with particle index in [lo, hi).
-    pub fn range(&self, lo: usize, hi: usize) -> (usize, usize) {
-        (self.idx.partition_point(|&i| (i as usize) < lo), self.idx.partition_point(|&i| (i as usize) < hi))
-    }
 }
 
-/// One wall contact: overlap `delta` along the outward normal `nrm`; hands wall `k`'s force and
-/// n × F_t to `on`. Returns (overlap, Coulomb excess, −∞ unless `audit`) for the diagnostics.
+/// One wall contact of a particle moving at (v, ω) = `motion`: overlap `delta` along the outward
+/// normal `nrm`, the particle-wall law of `p`; hands wall `k`'s force and n × F_t to `on`.
+/// Returns (overlap, Coulomb excess, −∞ unless `p.audit`) for the diagnostics.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 fn wall_contact<const FR: bool>(
-    law: &ContactLaw,
-    audit: bool,
-    r: f64,
-    h: f64,
+    p: &DemParams,
     k: usize,
     delta: f64,
     nrm: V3,
-    vi: V3,
-    wi: V3,
+    (vi, wi): (V3, V3),
     hist: &mut V3,
     on: &mut impl FnMut(usize, &[f64; 6]),
 ) -> (f64, f64) {
@@ -71,10 +62,11 @@ fn wall_contact<const FR: bool>(
         *hist = [0.0; 3];
         return (0.0, f64::NEG_INFINITY);
     }
+    let r = p.radius;
     let ws = [r * wi[0], r * wi[1], r * wi[2]];
-    let cf = contact_force::<FR>(law, delta, nrm, vi, ws, hist, h);
+    let cf = contact_force::<FR>(&p.wall, delta, nrm, vi, ws, hist, p.dt);
     on(k, &[cf.f[0], cf.f[1], cf.f[2], cf.c[0], cf.c[1], cf.c[2]]);
-    (delta, if FR && audit { cf.excess } else { f64::NEG_INFINITY })
+    (delta, if FR && p.audit { cf.excess } else { f64::NEG_INFINITY })
 }
 
 /// Every wall contact of a particle at `xi`: wall k (0 plate, 1 tube, 2 lid) hands its force
@@ -88,24 +80,23 @@ fn each_wall<const FR: bool>(
     hist: &mut [V3; 3],
     mut on: impl FnMut(usize, &[f64; 6]),
 ) -> (f64, f64) {
-    let (law, audit, r, h) = (&p.wall, p.audit, p.radius, p.dt);
+    let r = p.radius;
     let [h0, h1, h2] = hist;
     // Distributor plate z = 0: normal (0,0,−1).
-    let (mut ov, mut ex) = wall_contact::<FR>(law, audit, r, h, 0, r - xi[2], [0.0, 0.0, -1.0], vi, wi, h0, &mut on);
+    let (mut ov, mut ex) = wall_contact::<FR>(p, 0, r - xi[2], [0.0, 0.0, -1.0], (vi, wi), h0, &mut on);
     // Tube of radius R_t: outward radial normal.
     let rho2 = xi[0] * xi[0] + xi[1] * xi[1];
     let reach = p.tube_radius - r;
     if rho2 > reach * reach {
         let rho = rho2.sqrt();
         let nrm = [xi[0] / rho, xi[1] / rho, 0.0];
-        let (o, e) = wall_contact::<FR>(law, audit, r, h, 1, rho - reach, nrm, vi, wi, h1, &mut on);
+        let (o, e) = wall_contact::<FR>(p, 1, rho - reach, nrm, (vi, wi), h1, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     } else {
         *h1 = [0.0; 3];
     }
     if p.lid {
-        let (o, e) =
-            wall_contact::<FR>(law, audit, r, h, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], vi, wi, h2, &mut on);
+        let (o, e) = wall_contact::<FR>(p, 2, xi[2] + r - p.height, [0.0, 0.0, 1.0], (vi, wi), h2, &mut on);
         (ov, ex) = (ov.max(o), ex.max(e));
     }
     (ov, ex)

@@ -76,6 +76,7 @@ impl Scratch {
     }
 
     /// Plan `chunks` chunks (fewer for small systems) over the list.
+    #[cfg(test)]
     pub fn plan(nl: &NeighborList, n: usize, chunks: usize) -> Scratch {
         let mut sc = Scratch::default();
         sc.replan(nl, n, chunks);

@@ -3,8 +3,10 @@
 //! and histories to ~1e-7 relative; its vector and portable variants agree bit for bit.
 
 use super::{test_case, with_damping};
+use crate::dem::batch::{Batch, Entry, PairInputs, CAP};
 use crate::dem::contact::contact_force;
-use crate::dem::pair_batch::{Batch, CAP};
+use crate::dem::kernel::{Isa, Kernel};
+use crate::dem::pair_batch::evaluate;
 use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemParams;
 use rand::{Rng, SeedableRng};
@@ -45,29 +47,28 @@ fn batch_against_scalar_law(n: usize) {
         for l in 0..n {
             let (i, j) = (2 * l, 2 * l + 1);
             let dx = [x[j][0] - x[i][0], x[j][1] - x[i][1], x[j][2] - x[i][2]];
-            b.set(l, l, i, j, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], 4.0 * r * r);
+            b.set(l, Entry { k: l, i, j }, dx, dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2], 4.0 * r * r);
         }
         for l in n..CAP {
             let junk = [[0.0; 3], [f64::NAN; 3], [1e-9, 0.0, 0.0]][l % 3];
-            b.set(l, 0, 0, 1, junk, junk[0] * junk[0], 4.0 * r * r);
+            b.set(l, Entry { k: 0, i: 0, j: 1 }, junk, junk[0] * junk[0], 4.0 * r * r);
         }
         b.m = n;
         b
     };
+    let inp = PairInputs { law: &p.pair, audit: true, r, h: p.dt, v: &v, w: &w };
     let mut batch = filled();
     let mut vector = None;
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && std::arch::is_x86_feature_detected!("bmi2")
-    {
+    if let Some(isa) = Isa::avx512() {
         let mut b2 = filled();
         let mut shear = shear0.clone();
-        let maxima = b2.evaluate::<true, true>(&p.pair, true, r, p.dt, &v, &w, &mut shear, 0);
+        let maxima = evaluate::<true, true>(isa, &mut b2, &inp, &mut shear, 0);
         vector = Some((b2, shear, maxima));
+    } else {
+        super::skip("batched_pair_kernel_matches_the_double_precision_contact_law (AVX-512 part)", "no AVX-512");
     }
     let mut shear = shear0.clone();
-    let maxima = batch.evaluate::<true, false>(&p.pair, true, r, p.dt, &v, &w, &mut shear, 0);
+    let maxima = evaluate::<true, false>(Isa::PORTABLE, &mut batch, &inp, &mut shear, 0);
     if let Some((b2, s2, m2)) = &vector {
         // the AVX-512 gather (`pair_simd::gather8`) gives the same lanes as the portable one
         let valid = |a: &[[f32; CAP]; 3]| a.map(|q| q[..n].to_vec());
@@ -115,13 +116,13 @@ fn rng_frac(l: usize) -> f64 {
     ((l * 37 % 41) as f64 + 0.5) / 41.0
 }
 
-/// The AVX-512 scan and gather (`pair_simd`) give the portable pair pass's forces, torques,
-/// contact flags and histories bit for bit, on a compressed lattice with random motion (both
-/// sticking and sliding contacts, histories live and fresh). On a CPU without AVX-512 the
-/// dispatch takes the portable code and the comparison is trivially equal.
+/// Every kernel path this CPU has (`Kernel::available`: the AVX-512 scan and gather of
+/// `pair_simd`, the AVX2 build) gives the portable pair pass's forces, torques, contact flags and
+/// histories bit for bit, on a compressed lattice with random motion (both sticking and sliding
+/// contacts, histories live and fresh). A path the CPU lacks is reported as skipped.
 #[test]
 fn vector_pair_pass_equals_the_portable_one() {
-    use crate::dem::forces::{pair_pass, Kernels, Scratch};
+    use crate::dem::forces::{pair_pass, Scratch};
     let case = with_damping(test_case(0.02, 0.03, false, 9.81, 1e-6), 0.1, 0.05, 0.3);
     let d = case.particles.diameter_m;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
@@ -151,32 +152,44 @@ fn vector_pair_pass_equals_the_portable_one() {
         *s = [1e-6 * rng.gen::<f32>(), -1e-6 * rng.gen::<f32>(), 1e-7];
         *t = rng.gen::<bool>() as u8;
     }
-    let run = |kernels: Kernels, audit: bool| {
+    let run = |kernel: Kernel, audit: bool| {
         let mut p = sys.p.clone();
         p.audit = audit;
         let mut nl = sys.near.list.clone();
         let mut sc = Scratch::plan(&nl, sys.x.len(), 3);
-        let st = pair_pass::<true>(&p, &sys.x, &sys.v, &sys.w, &mut nl, &mut sc, kernels);
+        let st = pair_pass::<true>(&p, (&sys.x, &sys.v, &sys.w), &mut nl, &mut sc, kernel);
         (st.overlap, st.coulomb_excess, sc.acc, nl.touch, nl.shear)
     };
-    let (portable, vector) = (run(Kernels::Portable, true), run(Kernels::Best, true));
+    let portable = run(Kernel::Portable, true);
     let touching = portable.3.iter().filter(|&&t| t == 1).count();
     assert!(touching > 1000 && touching < portable.3.len(), "{touching} of {} entries touch", portable.3.len());
     assert!(portable.1 > -1e-6, "some contacts slide (Coulomb excess {})", portable.1);
-    assert_eq!(portable.0.to_bits(), vector.0.to_bits(), "largest overlap");
-    assert_eq!(portable.1.to_bits(), vector.1.to_bits(), "largest Coulomb excess");
     let first_diff = |a: Vec<u64>, b: Vec<u64>| a.iter().zip(&b).position(|(x, y)| x != y);
     let flags = |t: &[u8]| t.iter().map(|&f| f as u64).collect::<Vec<_>>();
-    assert_eq!(first_diff(flags(&portable.3), flags(&vector.3)), None, "contact flags");
     let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(|f| f.to_bits() as u64).collect::<Vec<_>>();
-    assert_eq!(first_diff(bits(&portable.2), bits(&vector.2)), None, "forces and torques (first differing value)");
     let bits3 = |a: &[[f32; 3]]| a.iter().flatten().map(|f| f.to_bits() as u64).collect::<Vec<_>>();
-    assert_eq!(first_diff(bits3(&portable.4), bits3(&vector.4)), None, "histories (first differing value)");
-    // Without the audit the pair pass skips the Coulomb diagnostic and nothing else.
-    let plain = run(Kernels::Best, false);
-    assert_eq!(plain.1, f64::NEG_INFINITY, "no diagnostic without the audit");
-    assert_eq!(plain.0.to_bits(), vector.0.to_bits(), "largest overlap without the audit");
-    assert_eq!(first_diff(bits(&plain.2), bits(&vector.2)), None, "forces without the audit");
-    assert_eq!(first_diff(bits3(&plain.4), bits3(&vector.4)), None, "histories without the audit");
-    assert!(plain.3 == vector.3, "contact flags without the audit");
+    for kernel in Kernel::ALL {
+        if !kernel.is_available() {
+            super::skip(&format!("vector_pair_pass_equals_the_portable_one ({kernel})"), "the CPU lacks it");
+            continue;
+        }
+        for audit in [true, false] {
+            let got = run(kernel, audit);
+            let what = format!("{kernel}, audit {audit}");
+            assert_eq!(portable.0.to_bits(), got.0.to_bits(), "largest overlap ({what})");
+            if audit {
+                assert_eq!(portable.1.to_bits(), got.1.to_bits(), "largest Coulomb excess ({what})");
+            } else {
+                // Without the audit the pair pass skips the Coulomb diagnostic and nothing else.
+                assert_eq!(got.1, f64::NEG_INFINITY, "no diagnostic without the audit ({what})");
+            }
+            assert_eq!(first_diff(flags(&portable.3), flags(&got.3)), None, "contact flags ({what})");
+            assert_eq!(
+                first_diff(bits(&portable.2), bits(&got.2)),
+                None,
+                "forces and torques, first difference ({what})"
+            );
+            assert_eq!(first_diff(bits3(&portable.4), bits3(&got.4)), None, "histories, first difference ({what})");
+        }
+    }
 }

@@ -4,7 +4,7 @@
 
 use super::energy::random_gas;
 use super::{test_case, with_damping};
-use crate::dem::forces::{pair_pass, Kernels, Scratch};
+use crate::dem::forces::{pair_pass, Scratch};
 use crate::dem::near_list::{Histories, NearList};
 use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemSystem;
@@ -98,7 +98,7 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     let n = s.len();
     let run = |nl: &mut crate::dem::neighbors::NeighborList| {
         let mut sc = Scratch::plan(nl, n, 1);
-        pair_pass::<true>(&s.p, &s.x, &s.v, &s.w, nl, &mut sc, Kernels::Best);
+        pair_pass::<true>(&s.p, (&s.x, &s.v, &s.w), nl, &mut sc, s.kernel());
         let mut acc = sc.acc;
         acc.resize(n, Default::default());
         acc

@@ -5,7 +5,8 @@
 //! one thread's chunk reaches the caller instead of leaving the other thread waiting for it.
 
 use super::checkpoint::{busy_system, same_state};
-use crate::dem::team_step::{pool_with_own_team, TeamLock, PANIC_IN_CHUNK};
+use crate::dem::team_lock::{solver_pool, TeamLock};
+use crate::dem::team_step::PANIC_IN_CHUNK;
 use crate::dem::DemSystem;
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
@@ -89,7 +90,7 @@ fn a_panic_in_a_chunk_reaches_the_caller_without_a_hang() {
 #[test]
 fn systems_on_pools_with_their_own_team_lock_both_run_as_teams() {
     let alone = pool().install(run_busy);
-    let pools: Vec<rayon::ThreadPool> = (0..2).map(|_| pool_with_own_team().num_threads(2).build().unwrap()).collect();
+    let pools: Vec<rayon::ThreadPool> = (0..2).map(|_| solver_pool().num_threads(2).build().unwrap()).collect();
     let both: Vec<DemSystem> = std::thread::scope(|sc| {
         let hs: Vec<_> = pools.iter().map(|p| sc.spawn(move || p.install(run_busy))).collect();
         hs.into_iter().map(|h| h.join().unwrap()).collect()
