@@ -3,6 +3,7 @@
 //! Prints `{"bench":"dem","kernel":…,"particles":…,"steps":…,"threads":…,"particle_steps_per_s":…}`
 //! per run, the kernel being the code path that ran (`FLUIDBED_KERNEL`, else the best the CPU has).
 //! `bench -- dem shaken`: the same with random initial velocities (lists refreshed often).
+//! `bench -- dem reproducible`: the cost of `dem.reproducible` (see `reproducible_cost`).
 //! `bench -- dem pour`: instead, time `build_bed` for the default particles poured to a settled
 //! height (7k bed: 30-mm column, 15 mm; 30k bed: 44-mm column, 30 mm), one JSON line each.
 
@@ -89,6 +90,9 @@ pub fn run() {
         pour(44.0, 30.0);
         return;
     }
+    if std::env::args().nth(2).as_deref() == Some("reproducible") {
+        return reproducible_cost();
+    }
     // `bench -- dem shaken`: the same bed with every particle thrown at up to 0.5 m/s (seeded),
     // so the lists are refreshed and rebuilt often, as in a bubbling bed.
     let shaken = std::env::args().nth(2).as_deref() == Some("shaken");
@@ -159,6 +163,53 @@ pub fn run() {
             );
         });
     }
+}
+
+/// `bench -- dem reproducible`: the settled bed stepped with the default work split and with
+/// `dem.reproducible` (fixed chunks) on all cores, interleaved in blocks of 200 steps in one
+/// process (so that the VM's drifts hit both alike); one JSON line with both rates.
+fn reproducible_cost() {
+    let Some(positions) = load_anchor() else {
+        eprintln!("{ANCHOR} not found");
+        std::process::exit(1);
+    };
+    let mut case = bench_case();
+    case.bed = Bed::Explicit(ExplicitBed { positions_m: positions.clone(), velocities_m_s: None });
+    let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+    pool.install(|| {
+        let mut systems: Vec<DemSystem> = [false, true]
+            .map(|on| {
+                let mut c = case.clone();
+                c.dem.reproducible = on;
+                DemSystem::new(&c, positions.clone(), vec![[0.0; 3]; positions.len()])
+            })
+            .into();
+        for s in systems.iter_mut() {
+            for _ in 0..1000 {
+                s.step();
+            }
+        }
+        let (rounds, block) = (10, 200);
+        let mut secs = [0.0f64; 2];
+        for _ in 0..rounds {
+            for (k, s) in systems.iter_mut().enumerate() {
+                let t0 = Instant::now();
+                for _ in 0..block {
+                    s.step();
+                }
+                secs[k] += t0.elapsed().as_secs_f64();
+            }
+        }
+        let rate = |k: usize| (positions.len() * rounds * block) as f64 / secs[k];
+        println!(
+            "{{\"bench\":\"dem_reproducible\",\"kernel\":\"{}\",\"threads\":{threads},\"default_particle_steps_per_s\":{:.0},\"reproducible_particle_steps_per_s\":{:.0},\"cost\":{:.3}}}",
+            systems[0].kernel(),
+            rate(0),
+            rate(1),
+            rate(0) / rate(1) - 1.0
+        );
+    });
 }
 
 /// FNV-1a over the bits of every position, velocity and spin: equal digests mean a code change

@@ -199,11 +199,15 @@ pub struct Dem {
     /// Worker threads for this run (0 = the pool's default).
     #[serde(default)]
     pub threads: usize,
+    /// The same bits for any thread count (a fixed work split of the pair pass; docs/BENCHMARKS.md
+    /// gives its cost); off, the split follows the thread count (the fast default).
+    #[serde(default)]
+    pub reproducible: bool,
 }
 
 impl Default for Dem {
     fn default() -> Self {
-        Dem { time_step_s: d_dem_dt(), skin_fraction: d_skin(), frozen: false, threads: 0 }
+        Dem { time_step_s: d_dem_dt(), skin_fraction: d_skin(), frozen: false, threads: 0, reproducible: false }
     }
 }
 

@@ -86,6 +86,10 @@ pub struct DemParams {
     pub audit: bool,
 }
 
+/// Pair-pass chunks of a reproducible run (`dem.reproducible`): fixed, so that the chunk sums and
+/// their order do not depend on the thread count; enough to share among 8 threads.
+pub const REPRODUCIBLE_CHUNKS: usize = 16;
+
 /// The near gap as a fraction of the skin: 0.1 and 0.2 ran the settled DEM bench at the same
 /// speed; 0.15 runs it 3–6% faster than walking the whole list (docs/BENCHMARKS.md).
 const NEAR_GAP: f64 = 0.15;
@@ -126,7 +130,7 @@ impl DemParams {
             wall: ContactLaw::new(case, r, m),
             friction: case.particles.sliding_friction > 0.0,
             extra_damping: 0.0,
-            work_chunks: 0,
+            work_chunks: if case.dem.reproducible { REPRODUCIBLE_CHUNKS } else { 0 },
             audit: false,
         }
     }

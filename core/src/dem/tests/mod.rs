@@ -9,6 +9,7 @@ mod kernel_paths;
 mod near_list;
 mod pair_scatter;
 mod poured_bed;
+mod reproducible;
 mod restitution;
 mod sliding;
 mod team_step;
