@@ -177,7 +177,10 @@ pub fn parts() {
             f();
         }
         let ms = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
-        println!("{}", json!({"bench": "coupled_part", "part": label, "ms_per_call": ms, "ns_per_particle": ms * 1e6 / dem.len() as f64}));
+        println!(
+            "{}",
+            json!({"bench": "coupled_part", "part": label, "ms_per_call": ms, "ns_per_particle": ms * 1e6 / dem.len() as f64})
+        );
     };
     let mut method = build_voidage(&case, grid);
     let (mut solid, mut eps) = (vec![0.0; n], vec![0.0; n]);
@@ -186,11 +189,18 @@ pub fn parts() {
     let (mut vel, mut rho, mut grad) = (vec![[0.0; 3]; n], vec![0.0; n], vec![[0.0; 3]; n]);
     time("gas_exchange_fields", &mut || gas.exchange_fields(&mut vel, &mut rho, &mut grad));
     let g = case.gas.as_ref().expect("gas");
-    let par = ExchangeParams { law: case.coupling.drag_law, mu: g.viscosity_pa_s, eps_min: g.drag_voidage_min, d: 2.0 * dem.radius() };
+    let par = ExchangeParams {
+        law: case.coupling.drag_law,
+        mu: g.viscosity_pa_s,
+        eps_min: g.drag_voidage_min,
+        d: 2.0 * dem.radius(),
+    };
     let at = GasAtCells { velocity_cyl: &vel, density: &rho, grad_p_cyl: &grad, voidage: &eps };
     let mut ex = Exchange::new(grid, dem.len());
     let (mut f, mut cf) = (vec![[0.0; 3]; dem.len()], vec![[0.0; 3]; n]);
-    time("particle_gas_forces", &mut || ex.particle_gas_forces(grid, &at, par, (dem.positions(), dem.velocities()), &mut f, &mut cf));
+    time("particle_gas_forces", &mut || {
+        ex.particle_gas_forces(grid, &at, par, (dem.positions(), dem.velocities()), &mut f, &mut cf)
+    });
     let mut gas2 = gas.clone();
     let dt = sim.plan().gas_dt_s.expect("gas dt");
     time("gas_step", &mut || gas2.step(dt));

@@ -8,6 +8,7 @@
 //!    the floor is inside the noise.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
+//!
 //! Last line: {"bench":"tradeoff","default_voidage","default_l1","default_ns_per_particle",
 //! "paper_sg3_l1","paper_sg3_ns_per_particle"} (per DEM step: the default at its interval, the
 //! paper's square grid configuration 3 at every step).
@@ -125,9 +126,15 @@ fn coupled_front() -> f64 {
     let r = stats(&ref_snaps, &grid);
     let (floor_snaps, _) = window(&bed(2), "tradeoff-seed2", 1);
     let floor = errors(&stats(&floor_snaps, &grid), &r);
-    println!("{}", json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1", "errors": floor}));
-    println!("{}", json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": 1, "wall_s_per_sim_s": ref_cost,
-        "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq}));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1", "errors": floor})
+    );
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": 1, "wall_s_per_sim_s": ref_cost,
+        "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
+    );
     let mut default_cost = ref_cost;
     for interval in [2u32, 5, 10, 20] {
         let (snaps, cost) = window(&reference, "tradeoff-seed1", interval);
@@ -135,14 +142,20 @@ fn coupled_front() -> f64 {
         if interval == reference.coupling.interval_steps {
             default_cost = cost;
         }
-        println!("{}", json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": interval,
-            "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq}));
+        println!(
+            "{}",
+            json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": interval,
+            "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+        );
     }
     let mut exact = reference.clone();
     exact.voidage = Voidage::ExactCylindrical;
     let (snaps, cost) = window(&exact, "tradeoff-exact", exact.coupling.interval_steps);
-    println!("{}", json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
-        "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)}));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
+        "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)})
+    );
     default_cost
 }
 
@@ -194,12 +207,18 @@ pub fn run() {
     let interval = case.coupling.interval_steps as f64;
     let sg3 = || -> Box<dyn VoidageMethod> { Box::new(SquareGrid::new(&g, 1.375e-3, BoxSplit::Cuboid, 1.0)) };
     let (sg3_l1, sg3_ns) = voidage_point(&g, a, &sg3);
-    println!("{}", json!({"bench": "tradeoff_voidage", "method": "square_grid cuboid config 3", "l1": sg3_l1, "ns_per_particle_call": sg3_ns}));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_voidage", "method": "square_grid cuboid config 3", "l1": sg3_l1, "ns_per_particle_call": sg3_ns})
+    );
     let mut best: Option<(String, f64, f64)> = None;
     for nodes in [2usize, 3, 4] {
         let (l, ns) = voidage_point(&g, a, &|| Box::new(ExactCylindrical::with_nodes(&g, nodes)));
-        println!("{}", json!({"bench": "tradeoff_voidage", "method": format!("exact_cylindrical {nodes} nodes"), "l1": l,
-            "ns_per_particle_call": ns, "ns_per_particle_step_at_default_interval": ns / interval}));
+        println!(
+            "{}",
+            json!({"bench": "tradeoff_voidage", "method": format!("exact_cylindrical {nodes} nodes"), "l1": l,
+            "ns_per_particle_call": ns, "ns_per_particle_step_at_default_interval": ns / interval})
+        );
         if best.as_ref().is_none_or(|b| ns < b.2) {
             best = Some((format!("exact_cylindrical {nodes} nodes"), l, ns));
         }

@@ -63,10 +63,11 @@ impl ValidationReport {
         self.push(Severity::Warning, path, value.into(), allowed, message)
     }
     /// Error unless lo <= x <= hi (with open ends when the flags say so); NaN is always an error.
+    #[allow(clippy::too_many_arguments)]
     fn range(&mut self, path: &str, x: f64, lo: f64, lo_open: bool, hi: f64, hi_open: bool, what: &str) {
         let ok_lo = if lo_open { x > lo } else { x >= lo };
         let ok_hi = if hi_open { x < hi } else { x <= hi };
-        if !(ok_lo && ok_hi) || !x.is_finite() {
+        if !(ok_lo && ok_hi && x.is_finite()) {
             let allowed =
                 format!("{}{}, {}{}", if lo_open { "(" } else { "[" }, lo, hi, if hi_open { ")" } else { "]" });
             self.error(path, json_num(x), allowed, format!("{what} out of range"));

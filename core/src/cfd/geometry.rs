@@ -5,6 +5,7 @@
 //! - radial faces between (i, j) and each outer neighbour (i+1, jj): the arc segment of r = r_{i+1}
 //!   shared by the two cells (the grid's shared-face fractions), whose *vector* area is the exact
 //!   integral r·dz·∫e_r dθ over the segment (a chord), so Σ S_f = 0 closes every cell exactly.
+//!
 //! Axial faces have area A_z = π dr²/n0 and normal ±e_z. The tube wall and the axis (zero area)
 //! carry no convective or viscous flux (full slip); see solver.rs for the pressure closure.
 

@@ -19,6 +19,7 @@
 //!   steady value is the Darcy flux of the same mismatch (cfd/mod.rs "Face mass flux");
 //! - stress ε∇·τ with τ = μ(∇u + ∇uᵀ) + (L − 2μ/3)(∇·u)I; for constant μ, ∇·τ = μ∇²u + (L + μ/3)∇(∇·u),
 //!   discretised as the compact face flux μ|S|/δ·(u_b − u_a) + (L + μ/3)·½(D_a + D_b)·S (eq. A.5–A.11).
+//!
 //! Sources: ρε g (−z) and the interaction force I (eq. A.12).
 
 use super::boundary::ramped_superficial_velocity;
@@ -283,6 +284,7 @@ pub fn axial_layer(
     }
 }
 
+#[allow(clippy::needless_range_loop)] // cells are indexed in several arrays at once
 /// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
 /// layer's horizontal face corrections into `out_fh`; `axial` holds the axial faces of
 /// `axial_layer` (the one below layer k at index k − 1, the one above at k).

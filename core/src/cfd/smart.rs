@@ -9,7 +9,7 @@ pub fn smart_face(u: f64, c: f64, d: f64) -> f64 {
         return c;
     }
     let r = (c - u) / dd;
-    let psi = (4.0 * r).min(0.75 + 0.25 * r).min(2.0).max(0.0);
+    let psi = (4.0 * r).min(0.75 + 0.25 * r).clamp(0.0, 2.0);
     c + 0.5 * psi * dd
 }
 

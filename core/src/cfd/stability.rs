@@ -42,7 +42,7 @@ pub fn case_stable_time_step(case: &Case) -> Option<f64> {
     let g = case.gas.as_ref()?;
     let (radius, dr, dz, n0) = (case.column.diameter_m / 2.0, case.grid.dr_m, case.grid_dz_m(), case.grid.n0);
     let ok = |x: f64| x.is_finite() && x > 0.0;
-    if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && radius / dr < 1e4 && n0 >= 1 && n0 <= 64) {
+    if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && radius / dr < 1e4 && (1..=64).contains(&n0)) {
         return None;
     }
     let (a, rho) = (g.sound_speed_m_s(), g.outlet_density_kg_m3());

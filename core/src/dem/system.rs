@@ -133,7 +133,7 @@ impl DemSystem {
         &mut self.ext
     }
     /// Positions and velocities with the external forces to be written, all in the current order.
-    pub fn coupling_views(&mut self) -> (&[[f64; 3]], &[[f64; 3]], &mut [[f64; 3]]) {
+    pub fn coupling_views(&mut self) -> CouplingViews<'_> {
         self.external_forces_mut();
         (&self.x, &self.v, &mut self.ext)
     }
@@ -491,6 +491,9 @@ impl DemSystem {
         self.builds.0 += 1;
     }
 }
+
+/// Positions, velocities (read) and external forces (written) of `DemSystem::coupling_views`.
+pub type CouplingViews<'a> = (&'a [V3], &'a [V3], &'a mut [V3]);
 
 /// √3, rounded up (the bound's factor from the largest component to the length).
 const SQRT_3: f64 = 1.7320508075688774;

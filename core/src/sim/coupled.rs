@@ -108,7 +108,7 @@ impl Simulation {
             let dt = self.st.case.dem.time_step_s;
             // Gas steps needed to reach the end of this DEM step (to within rounding).
             let target = ((self.st.steps + 1) as f64 * dt / dt_g - 1e-9).ceil() as u64;
-            if self.st.steps % interval == 0 {
+            if self.st.steps.is_multiple_of(interval) {
                 self.couple();
             }
             let t = self.time();
@@ -116,7 +116,7 @@ impl Simulation {
             let t0 = std::time::Instant::now();
             while gas.steps() < target {
                 gas.step(dt_g);
-                if gas.steps() % watchdog::GAS_CHECK_EVERY == 0 {
+                if gas.steps().is_multiple_of(watchdog::GAS_CHECK_EVERY) {
                     watchdog::check_gas(gas, dt_g, t)?;
                 }
             }

@@ -185,7 +185,7 @@ impl Simulation {
                 break;
             }
             self.step()?;
-            if self.st.steps % self.steps_per_snapshot == 0 || self.st.steps == self.end_steps {
+            if self.st.steps.is_multiple_of(self.steps_per_snapshot) || self.st.steps == self.end_steps {
                 let t0 = std::time::Instant::now();
                 let s = self.take_snapshot();
                 self.timers.output += t0.elapsed().as_secs_f64();

@@ -28,14 +28,14 @@ pub fn check_gas(gas: &GasSolver, dt: f64, t: f64) -> Result<(), SimError> {
 
 pub fn check_dem(dem: &DemSystem, steps: u64, t: f64) -> Result<(), SimError> {
     let ov = dem.max_overlap_fraction();
-    if !(ov <= MAX_OVERLAP_FRACTION) {
+    if ov.is_nan() || ov > MAX_OVERLAP_FRACTION {
         return Err(SimError::Unstable(format!(
             "particle overlap {:.1}% of d at t = {t:.6} s exceeds {:.0}%; lower dem.time_step_s or raise particles.youngs_modulus_pa",
             ov * 100.0,
             MAX_OVERLAP_FRACTION * 100.0
         )));
     }
-    if steps % 100 == 0 {
+    if steps.is_multiple_of(100) {
         if let Some(k) = dem.positions().iter().position(|p| !p.iter().all(|x| x.is_finite())) {
             return Err(SimError::Unstable(format!(
                 "particle {} has a non-finite position at t = {t:.6} s; lower dem.time_step_s",

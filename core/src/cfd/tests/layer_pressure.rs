@@ -44,8 +44,8 @@ impl Zone {
         s.set_initial_voidage(&eps);
         let dt = s.stable_dt();
         for _ in 0..self.steps {
-            for c in 0..s.grid().num_cells() {
-                let (e, rho, u) = (eps[c], s.density(c), s.velocity_cyl(c));
+            for (c, &e) in eps.iter().enumerate() {
+                let (rho, u) = (s.density(c), s.velocity_cyl(c));
                 let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
                 let beta = if e < 1.0 { beta_a(MU, D, e, rho * e * speed * D / MU) } else { 0.0 };
                 s.interaction_force_mut()[c] = [-beta * u[0], -beta * u[1], -beta * u[2]];

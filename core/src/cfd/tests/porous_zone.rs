@@ -46,8 +46,8 @@ fn porous_zone_pressure_drop_matches_model_a_beetstra() {
     let dt = s.stable_dt();
     for _ in 0..12_000 {
         // Particles at rest: I = −β_A u, β_A = 18μεφF(ε, Re)/d², Re = ρε|u|d/μ.
-        for c in 0..s.grid().num_cells() {
-            let (e, rho, u) = (eps[c], s.density(c), s.velocity_cyl(c));
+        for (c, &e) in eps.iter().enumerate() {
+            let (rho, u) = (s.density(c), s.velocity_cyl(c));
             let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
             let beta = 18.0 * mu * e * (1.0 - e) * beetstra_f(e, rho * e * speed * d / mu) / (d * d);
             s.interaction_force_mut()[c] = [-beta * u[0], -beta * u[1], -beta * u[2]];

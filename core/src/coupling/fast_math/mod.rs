@@ -13,7 +13,7 @@ use tables::{EXP2_64THS, INV_C, LN_C};
 
 /// ln 2 and ln 2 / 64 split into a high part with trailing zero bits (exact products with small
 /// integers) and the rest (Cody–Waite).
-const LN2_HI: f64 = 6.931_471_803_691_238_2e-1;
+const LN2_HI: f64 = 0.693_147_180_369_123_8;
 const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
 const LN2_64_HI: f64 = LN2_HI / 64.0;
 const LN2_64_LO: f64 = LN2_LO / 64.0;

@@ -70,6 +70,7 @@ fn polygon_disk_area(poly: &[P], s: f64) -> f64 {
 }
 
 /// Area of the rectangle [x0,x1]×[y0,y1] inside the polar cell r0 ≤ r ≤ r1, θ0 ≤ θ ≤ θ1 (exact).
+#[allow(clippy::too_many_arguments)]
 pub fn rect_cell_area(x0: f64, x1: f64, y0: f64, y1: f64, r0: f64, r1: f64, th0: f64, th1: f64) -> f64 {
     if th1 - th0 > PI {
         // a wedge wider than π is not convex: split it
