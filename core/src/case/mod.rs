@@ -2,6 +2,8 @@
 //! Defaults are the paper's Table 1 (contacts) and section 3 (the 44-mm bed, d = 1.2 mm).
 //! A case without a `gas` section runs DEM alone.
 
+pub mod bounds;
+pub mod strict_json;
 mod validate;
 
 pub use validate::{Problem, Severity, ValidationReport};

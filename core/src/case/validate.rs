@@ -125,9 +125,14 @@ impl Case {
 
     /// Parse JSON text (a syntax error is reported at path "" with its line and column).
     pub fn parse_str(s: &str) -> Result<(Case, ValidationReport), ValidationReport> {
-        match serde_json::from_str::<Value>(s) {
+        match super::strict_json::parse(s) {
             Ok(v) => Case::parse_value(&v),
-            Err(e) => {
+            Err(super::strict_json::StrictJsonError::DuplicateKey { pointer, message }) => {
+                let mut r = ValidationReport::default();
+                r.error(&pointer, Value::Null, "each key once", message);
+                Err(r)
+            }
+            Err(super::strict_json::StrictJsonError::Syntax(e)) => {
                 let mut r = ValidationReport::default();
                 r.error("", Value::Null, "valid JSON", format!("malformed JSON: {e}"));
                 Err(r)
@@ -210,6 +215,7 @@ impl Case {
         if !(1..=1000).contains(&n) {
             r.error("/coupling/interval_steps", n, "[1, 1000]", "DEM steps between couplings out of range");
         }
+        r.errors.extend(super::bounds::check(self));
         r
     }
 

@@ -50,8 +50,19 @@ const BED_CHUNKS: usize = 8;
 /// Bump when the algorithm changes (invalidates cached beds).
 const ALGORITHM_VERSION: u32 = 2;
 
+/// Asked between steps of the pour: true stops it at once (a cancel, a server stop).
+pub type Stop<'a> = &'a (dyn Fn() -> bool + Sync);
+
+/// What a stopped pour returns as its error.
+pub const STOPPED: &str = "bed preparation stopped";
+
 /// The settled bed for `case` (positions, velocities); explicit beds are returned as given.
 pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<V3>), String> {
+    build_bed_until(case, cache_dir, &|| false)
+}
+
+/// `build_bed` that gives up with [`STOPPED`] as soon as `stop` says so.
+pub fn build_bed_until(case: &Case, cache_dir: Option<&Path>, stop: Stop) -> Result<(Vec<V3>, Vec<V3>), String> {
     let g = match &case.bed {
         Bed::Explicit(e) => {
             let v = e.velocities_m_s.clone().unwrap_or_else(|| vec![[0.0; 3]; e.positions_m.len()]);
@@ -68,7 +79,7 @@ pub fn build_bed(case: &Case, cache_dir: Option<&Path>) -> Result<(Vec<V3>, Vec<
             }
         }
     }
-    let bed = generate(case, g.count, g.settled_height_m, g.seed, None)?;
+    let bed = generate_until(case, g.count, g.settled_height_m, g.seed, None, stop)?;
     if let (Some(f), Some(dir)) = (&file, cache_dir) {
         std::fs::create_dir_all(dir).map_err(|e| format!("bed cache {}: {e}", dir.display()))?;
         let tmp = f.with_extension(format!("tmp{}", std::process::id()));
@@ -85,7 +96,18 @@ pub fn generate(
     count: Option<usize>,
     height: Option<f64>,
     seed: u64,
+    observe: Option<&mut dyn FnMut(&DemSystem)>,
+) -> Result<(Vec<V3>, Vec<V3>), String> {
+    generate_until(case, count, height, seed, observe, &|| false)
+}
+
+fn generate_until(
+    case: &Case,
+    count: Option<usize>,
+    height: Option<f64>,
+    seed: u64,
     mut observe: Option<&mut dyn FnMut(&DemSystem)>,
+    stop: Stop,
 ) -> Result<(Vec<V3>, Vec<V3>), String> {
     let rt = case.column.diameter_m / 2.0;
     let area = std::f64::consts::PI * rt * rt;
@@ -95,13 +117,13 @@ pub fn generate(
         (None, None) => return Err("bed.generated needs settled_height_m or count".into()),
     };
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let x = insert_random(case, n, &mut rng)?;
+    let x = insert_random(case, n, &mut rng, stop)?;
     // Pour soft and damped (fast settling); no lid while pouring.
     let e_real = case.particles.youngs_modulus_pa;
     let e_floor = POUR_E_FLOOR_RHO_V2 * case.particles.density_kg_m3;
     let e_pour = (e_real / POUR_SOFTENING).max(e_floor).min(e_real);
     let mut sys = DemSystem::with_params(pour_params(case, e_pour, false), x, vec![[0.0; 3]; n]);
-    settle(&mut sys, POUR_SPEED, &mut observe)?;
+    settle(&mut sys, POUR_SPEED, &mut observe, stop)?;
     if let (None, Some(h)) = (count, height) {
         let r = case.particles.diameter_m / 2.0;
         let x = sys.positions();
@@ -123,14 +145,14 @@ pub fn generate(
         sys.set_params(p);
         // The last stage settles to the final threshold while still damped (the case's own
         // damping may be weak, e ≈ 0.97, and would ring for long).
-        settle(&mut sys, if last { RELAX_SPEED } else { POUR_SPEED }, &mut observe)?;
+        settle(&mut sys, if last { RELAX_SPEED } else { POUR_SPEED }, &mut observe, stop)?;
     }
     // Final relaxation with the case's own parameters.
     let mut p = DemParams::new(case);
     p.lid = false;
     p.work_chunks = BED_CHUNKS;
     sys.set_params(p);
-    settle(&mut sys, RELAX_SPEED, &mut observe)?;
+    settle(&mut sys, RELAX_SPEED, &mut observe, stop)?;
     Ok((sys.positions().to_vec(), sys.velocities().to_vec()))
 }
 
@@ -152,12 +174,20 @@ fn pour_params(case: &Case, e: f64, last: bool) -> DemParams {
 }
 
 /// Step until the mean kinetic energy per particle falls below ½ m `speed`², checked every 200 steps.
-fn settle(sys: &mut DemSystem, speed: f64, observe: &mut Option<&mut dyn FnMut(&DemSystem)>) -> Result<(), String> {
+fn settle(
+    sys: &mut DemSystem,
+    speed: f64,
+    observe: &mut Option<&mut dyn FnMut(&DemSystem)>,
+    stop: Stop,
+) -> Result<(), String> {
     sys.set_audit(observe.is_some());
     let dt = sys.params().dt;
     let limit = 0.5 * sys.params().mass * speed * speed * sys.len() as f64;
     let max_steps = (MAX_PHASE_TIME_S / dt) as u64;
     for s in 1..=max_steps {
+        if stop() {
+            return Err(STOPPED.into());
+        }
         sys.step();
         if let Some(f) = observe.as_mut() {
             f(sys);
@@ -174,7 +204,7 @@ fn settle(sys: &mut DemSystem, speed: f64, observe: &mut Option<&mut dyn FnMut(&
 
 /// Random sequential addition of `n` non-overlapping spheres in the tube, bottom up: the
 /// insertion column is tall enough for a packing fraction of INSERT_FRACTION.
-fn insert_random(case: &Case, n: usize, rng: &mut ChaCha8Rng) -> Result<Vec<V3>, String> {
+fn insert_random(case: &Case, n: usize, rng: &mut ChaCha8Rng, stop: Stop) -> Result<Vec<V3>, String> {
     let d = case.particles.diameter_m;
     let r = d / 2.0;
     let reach = case.column.diameter_m / 2.0 - r * 1.01;
@@ -194,6 +224,9 @@ fn insert_random(case: &Case, n: usize, rng: &mut ChaCha8Rng) -> Result<Vec<V3>,
     let mut tries = 0usize;
     while out.len() < n {
         tries += 1;
+        if tries & 4095 == 0 && stop() {
+            return Err(STOPPED.into());
+        }
         if tries > 2000 * n + 100_000 {
             return Err("random insertion could not place all particles".into());
         }
@@ -269,4 +302,23 @@ fn decode(b: &[u8]) -> Option<(Vec<V3>, Vec<V3>)> {
     let f = |k: usize| f64::from_le_bytes(b[16 + 8 * k..24 + 8 * k].try_into().unwrap());
     let vec = |o: usize| (0..n).map(|i| [f(o + 3 * i), f(o + 3 * i + 1), f(o + 3 * i + 2)]).collect();
     Some((vec(0), vec(3 * n)))
+}
+
+#[cfg(test)]
+mod stop_tests {
+    use super::*;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    #[test]
+    fn a_pour_stops_when_asked() {
+        let case: Case = serde_json::from_value(serde_json::json!({
+            "column": { "diameter_m": 0.02, "height_m": 0.05 }, "particles": {},
+            "bed": { "generated": { "count": 500 } }
+        }))
+        .unwrap();
+        let asked = AtomicUsize::new(0);
+        let stop = || asked.fetch_add(1, Ordering::SeqCst) >= 50;
+        assert_eq!(build_bed_until(&case, None, &stop), Err(STOPPED.to_string()));
+        assert_eq!(asked.load(Ordering::SeqCst), 51, "stopped at the first question answered yes");
+    }
 }

@@ -6,6 +6,7 @@ pub mod npy;
 pub mod plot;
 pub mod png;
 pub mod vtk;
+pub mod vtk_xml;
 
 #[cfg(test)]
 mod tests;

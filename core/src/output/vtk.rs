@@ -25,8 +25,17 @@ pub fn segments(grid: &CylGrid, i: usize) -> usize {
     (grid.dtheta(i) / MAX_SEGMENT_RAD).ceil().max(1.0) as usize
 }
 
-/// The grid with the given cell fields (each of length `grid.num_cells()`).
-pub fn cells(grid: &CylGrid, title: &str, fields: &[CellField]) -> String {
+/// The cells as VTK sees them: points, per-cell point lists and kinds, and each VTK cell's fluid
+/// cell (`parent`).
+pub struct Geometry {
+    pub points: Vec<[f64; 3]>,
+    pub conn: Vec<Vec<usize>>,
+    pub kinds: Vec<u8>,
+    pub parent: Vec<usize>,
+}
+
+/// The grid's cells split into hexahedra and wedges (see the module comment).
+pub fn geometry(grid: &CylGrid) -> Geometry {
     let mut points: Vec<[f64; 3]> = Vec::new();
     let mut conn: Vec<Vec<usize>> = Vec::new();
     let mut kinds: Vec<u8> = Vec::new();
@@ -61,6 +70,12 @@ pub fn cells(grid: &CylGrid, title: &str, fields: &[CellField]) -> String {
             }
         }
     }
+    Geometry { points, conn, kinds, parent }
+}
+
+/// The grid with the given cell fields (each of length `grid.num_cells()`).
+pub fn cells(grid: &CylGrid, title: &str, fields: &[CellField]) -> String {
+    let Geometry { points, conn, kinds, parent } = geometry(grid);
     let mut out = String::new();
     let _ = writeln!(out, "# vtk DataFile Version 3.0\n{}\nASCII\nDATASET UNSTRUCTURED_GRID", one_line(title));
     let _ = writeln!(out, "POINTS {} double", points.len());
