@@ -180,6 +180,12 @@ async fn dispatch(cli: Cli) -> i32 {
         Err(e) => return fail(exit::USAGE, &format!("bad --server or --token: {e}")),
     };
     let j = cli.json;
+    // A job id is 16 hex digits: anything else (`../../x`) would leave the output folder or the URL.
+    if let Verb::Status { id } | Verb::Watch { id } | Verb::Fetch { id, .. } | Verb::Cancel { id } = &cli.verb {
+        if id.is_empty() || id.len() > 64 || !id.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-') {
+            return fail(exit::USAGE, &format!("`{id}` is not a job id (letters, digits and '-')"));
+        }
+    }
     match cli.verb {
         Verb::Validate { .. } => exit::OK,
         Verb::Submit { case } => {

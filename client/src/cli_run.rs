@@ -27,6 +27,9 @@ pub async fn run(
     let Some((text, _name)) = ok else { return code };
     let stem = case.file_stem().and_then(|s| s.to_str()).unwrap_or("case").to_string();
     let out = out.unwrap_or_else(|| PathBuf::from("fluidbed-out").join(&stem));
+    if let Err(m) = fresh_out(&out) {
+        return fail(exit::USAGE, &m);
+    }
     let (api, embedded) = match server {
         Some(api) => (api, None),
         None => match start_embedded(&out, threads, token.as_deref()) {
@@ -45,6 +48,31 @@ pub async fn run(
     #[cfg(not(feature = "embedded"))]
     let _ = embedded;
     code
+}
+
+/// Marks a folder as written by `fluidbed run`, so that a later run may replace it whole.
+const RUN_MARKER: &str = ".fluidbed-run";
+
+/// Make `out` an empty folder for this run's results: a previous run's folder is replaced (no
+/// stale files beside new ones); any other non-empty folder is refused.
+fn fresh_out(out: &std::path::Path) -> Result<(), String> {
+    let entries = match std::fs::read_dir(out) {
+        Ok(rd) => rd.count(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => 0,
+        Err(e) => return Err(format!("cannot read the output folder {}: {e}", out.display())),
+    };
+    if entries > 0 {
+        if !out.join(RUN_MARKER).is_file() {
+            return Err(format!(
+                "the output folder {} is not empty and was not written by `fluidbed run`: choose another --out",
+                out.display()
+            ));
+        }
+        std::fs::remove_dir_all(out).map_err(|e| format!("cannot clear {}: {e}", out.display()))?;
+    }
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::write(out.join(RUN_MARKER), b"results of `fluidbed run`; the next run into this folder replaces it\n")
+        .map_err(|e| format!("cannot write in {}: {e}", out.display()))
 }
 
 async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, formats: &Formats, json_out: bool) -> i32 {

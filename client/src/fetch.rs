@@ -1,6 +1,6 @@
 //! Download a job's results into a folder: the ΔP series as CSV, every snapshot's voidage as
-//! .npy and its cells (and particles, when stored) as legacy .vtk with a .pvd time series for
-//! ParaView, and PNGs of the last voidage slice and of the ΔP (or bed-height) trace.
+//! .npy and its cells (and particles, when stored) as VTK XML .vtu (.vtp) with a .pvd time series
+//! for ParaView, and PNGs of the last voidage slice and of the ΔP (or bed-height) trace.
 
 use crate::api::{Api, ApiError};
 use serde_json::Value;
@@ -62,22 +62,22 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
             }
         }
         if formats.npy {
-            for field in ["voidage", "pressure"] {
+            for field in ["voidage", "pressure", "gas_velocity"] {
                 if let Some(b) = api.get_bytes(&format!("{snap}?format=npy&field={field}")).await? {
                     save(format!("{field}_{n:06}.npy"), b)?;
                 }
             }
         }
         if formats.vtk {
-            if let Some(b) = api.get_bytes(&format!("{snap}?format=vtk")).await? {
-                save(format!("cells_{n:06}.vtk"), b)?;
-                pvd_cells.push((t, format!("cells_{n:06}.vtk")));
+            if let Some(b) = api.get_bytes(&format!("{snap}?format=vtu")).await? {
+                save(format!("cells_{n:06}.vtu"), b)?;
+                pvd_cells.push((t, format!("cells_{n:06}.vtu")));
             }
             if particles_stored {
-                match api.get_bytes(&format!("{snap}?format=vtk&what=particles")).await? {
+                match api.get_bytes(&format!("{snap}?format=vtp&what=particles")).await? {
                     Some(b) => {
-                        save(format!("particles_{n:06}.vtk"), b)?;
-                        pvd_particles.push((t, format!("particles_{n:06}.vtk")));
+                        save(format!("particles_{n:06}.vtp"), b)?;
+                        pvd_particles.push((t, format!("particles_{n:06}.vtp")));
                     }
                     None => particles_stored = false,
                 }

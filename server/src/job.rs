@@ -55,6 +55,10 @@ pub struct Job {
     pub message: Option<String>,
     pub warnings: Vec<Value>,
     pub plan: Option<Value>,
+    /// A DELETE was accepted: the job ends `cancelled` even across a restart.
+    pub cancel_requested: bool,
+    /// Starts not given back by a clean stop: how often this job went down with its server.
+    pub attempts: u32,
 }
 
 /// One row of a job's snapshot index.

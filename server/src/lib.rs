@@ -10,7 +10,9 @@
 
 pub mod api;
 pub mod events;
+pub mod health;
 pub mod job;
+pub mod listener;
 pub mod store;
 pub mod worker;
 
@@ -38,6 +40,16 @@ pub struct Config {
     pub max_queued: usize,
     /// Sustained job submissions per second (token bucket, burst of 4 seconds' worth); more are 429.
     pub submissions_per_s: f64,
+    /// Largest estimated peak memory of one job (`case::bounds`); larger cases are refused (422).
+    pub max_job_memory: u64,
+    /// Most client connections at once (also kept below the open-file limit).
+    pub max_connections: usize,
+    /// A request head must arrive within this; also how long an idle connection stays open.
+    pub header_read_timeout: Duration,
+    /// A request body may pause this long between chunks.
+    pub body_read_timeout: Duration,
+    /// A request (not a streamed response) must be read and answered within this.
+    pub request_timeout: Duration,
 }
 
 impl Config {
@@ -51,6 +63,11 @@ impl Config {
             max_body_bytes: 16 << 20,
             max_queued: 64,
             submissions_per_s: 5.0,
+            max_job_memory: 8 << 30,
+            max_connections: 512,
+            header_read_timeout: Duration::from_secs(20),
+            body_read_timeout: Duration::from_secs(20),
+            request_timeout: Duration::from_secs(60),
         }
     }
 }
@@ -62,9 +79,12 @@ pub struct App {
     pub hub: events::Hub,
     pub queue: worker::Queue,
     pub cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
+    pub health: health::Health,
     /// Submission token bucket: (tokens, last refill).
     submit_bucket: Mutex<(f64, Instant)>,
     stopping: AtomicBool,
+    /// Set with `stopping` by a clean shutdown (SIGTERM): running jobs checkpoint first.
+    graceful: AtomicBool,
 }
 
 impl App {
@@ -72,6 +92,10 @@ impl App {
     /// resumed from their checkpoint by the next server on this data directory.
     pub fn stopping(&self) -> bool {
         self.stopping.load(Ordering::SeqCst)
+    }
+    /// Whether the stop is a clean shutdown (not `Server::kill`).
+    pub fn graceful(&self) -> bool {
+        self.graceful.load(Ordering::SeqCst)
     }
     /// Take one submission token; false when the client must slow down.
     pub fn take_submission_token(&self) -> bool {
@@ -110,8 +134,10 @@ impl Server {
             hub: events::Hub::default(),
             queue: worker::Queue::default(),
             cancels: Mutex::new(HashMap::new()),
+            health: health::Health::default(),
             submit_bucket: Mutex::new((4.0 * config.submissions_per_s, Instant::now())),
             stopping: AtomicBool::new(false),
+            graceful: AtomicBool::new(false),
             config,
         });
         // Jobs that were running resume from their last checkpoint; queued ones queue again.
@@ -131,14 +157,13 @@ impl Server {
             .build()?;
         let (shutdown_tx, shutdown_rx) = tokio::sync::oneshot::channel::<()>();
         let router = api::router(app.clone());
-        runtime.spawn(async move {
-            let listener = tokio::net::TcpListener::from_std(listener).expect("listener");
-            let _ = axum::serve(listener, router)
-                .with_graceful_shutdown(async {
-                    let _ = shutdown_rx.await;
-                })
-                .await;
-        });
+        let (header_timeout, connections) =
+            (app.config.header_read_timeout, listener::connection_budget(app.config.max_connections));
+        let listener = {
+            let _guard = runtime.enter();
+            tokio::net::TcpListener::from_std(listener)?
+        };
+        runtime.spawn(listener::serve(listener, router, header_timeout, connections, shutdown_rx));
         let workers = worker::spawn(&app, app.config.workers);
         Ok(Server { addr, app, runtime: Some(runtime), shutdown_tx: Some(shutdown_tx), workers })
     }
@@ -150,13 +175,18 @@ impl Server {
         format!("http://{}", self.addr)
     }
 
-    /// Stop: no new requests, workers stop between chunks; running jobs stay `running` in the
-    /// store and resume from their checkpoints on the next start.
+    /// Stop: no new requests; workers checkpoint at their next chunk (a pour stops at once);
+    /// running jobs stay `running` in the store and resume from there on the next start. The
+    /// database's WAL is folded in and closed.
     pub fn shutdown(mut self) {
         if let Some(tx) = self.shutdown_tx.take() {
             let _ = tx.send(());
         }
+        self.app.graceful.store(true, Ordering::SeqCst);
         self.stop(Duration::from_secs(30));
+        if let Err(e) = self.app.store.close() {
+            eprintln!("fluidbed-server: closing the job database: {e:#}");
+        }
     }
 
     /// Drop the server as a crash would: the HTTP runtime is torn down at once and the workers

@@ -32,6 +32,42 @@ struct Args {
     /// Sustained job submissions per second (bursts of 4 s worth); 0 = unlimited.
     #[arg(long, default_value_t = 5.0)]
     submissions_per_s: f64,
+    /// Largest estimated peak memory of one job, e.g. 8G, 512M; larger cases are refused (422).
+    #[arg(long, default_value = "8G", value_parser = parse_bytes)]
+    max_job_memory: u64,
+    /// Most client connections at once (kept below the open-file limit).
+    #[arg(long, default_value_t = 512)]
+    max_connections: usize,
+    /// Seconds a client has to send a request's head; an idle connection is closed after this.
+    #[arg(long, default_value_t = 20)]
+    header_timeout_s: u64,
+    /// Seconds a request body may pause between chunks.
+    #[arg(long, default_value_t = 20)]
+    body_timeout_s: u64,
+}
+
+/// A byte count with an optional K, M, G or T suffix (powers of 1024).
+fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (num, shift) = match t.char_indices().last() {
+        Some((i, c)) if c.is_ascii_alphabetic() => {
+            let shift = match c.to_ascii_uppercase() {
+                'K' => 10,
+                'M' => 20,
+                'G' => 30,
+                'T' => 40,
+                _ => return Err(format!("unknown size suffix `{c}` (K, M, G, T)")),
+            };
+            (&t[..i], shift)
+        }
+        _ => (t, 0),
+    };
+    let n: f64 = num.trim().parse().map_err(|_| format!("`{s}` is not a size such as 8G or 512M"))?;
+    let bytes = n * (1u64 << shift) as f64;
+    if !(bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("`{s}` is out of range"));
+    }
+    Ok(bytes as u64)
 }
 
 fn default_threads() -> usize {
@@ -49,9 +85,20 @@ fn main() -> anyhow::Result<()> {
         max_body_bytes: a.max_body_bytes,
         max_queued: a.max_queued,
         submissions_per_s: a.submissions_per_s,
+        max_job_memory: a.max_job_memory,
+        max_connections: a.max_connections,
+        header_read_timeout: std::time::Duration::from_secs(a.header_timeout_s.max(1)),
+        body_read_timeout: std::time::Duration::from_secs(a.body_timeout_s.max(1)),
+        request_timeout: std::time::Duration::from_secs(60.max(3 * a.body_timeout_s)),
     };
     let dir = cfg.data_dir.clone();
-    let server = Server::start(cfg)?;
+    let server = match Server::start(cfg) {
+        Ok(s) => s,
+        Err(e) => {
+            eprintln!("fluidbed-server: cannot start: {e:#}");
+            std::process::exit(1);
+        }
+    };
     eprintln!("fluidbed-server: listening on {} (data in {})", server.url(), dir.display());
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
     rt.block_on(async {

@@ -7,6 +7,7 @@
 //! DIR/jobs/<id>/snapshots/<n>.bin  snapshot n (bincode of core's Snapshot, raw f64)
 //! DIR/jobs/<id>/checkpoint.bin   the complete simulation state after the last checkpoint
 //! DIR/cache/                     settled beds shared between jobs (core's bed cache)
+//! DIR/reserve.bin                space set aside so that a full disk can still record a failure
 //! ```
 //! A job's folder is created by the worker that runs it, so a rejected request writes nothing.
 
@@ -40,7 +41,9 @@ CREATE TABLE IF NOT EXISTS jobs (
   eta_s REAL,
   message TEXT,
   warnings TEXT NOT NULL,
-  plan TEXT
+  plan TEXT,
+  cancel_requested INTEGER NOT NULL DEFAULT 0,
+  attempts INTEGER NOT NULL DEFAULT 0
 );
 CREATE INDEX IF NOT EXISTS jobs_status ON jobs(status);
 CREATE TABLE IF NOT EXISTS snapshots (
@@ -53,7 +56,14 @@ CREATE TABLE IF NOT EXISTS snapshots (
   PRIMARY KEY (job_id, n)
 );";
 
-const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan";
+/// Columns added after the first release, with their definitions (added to older databases).
+const ADDED_COLUMNS: [(&str, &str); 2] =
+    [("cancel_requested", "INTEGER NOT NULL DEFAULT 0"), ("attempts", "INTEGER NOT NULL DEFAULT 0")];
+
+/// Bytes kept in DIR/reserve.bin: freed when a write fails, so that SQLite can still mark the job.
+const RESERVE_BYTES: usize = 256 << 10;
+
+const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts";
 
 fn job_of(r: &rusqlite::Row) -> rusqlite::Result<Job> {
     let status: String = r.get(2)?;
@@ -74,18 +84,76 @@ fn job_of(r: &rusqlite::Row) -> rusqlite::Result<Job> {
         message: r.get(11)?,
         warnings: serde_json::from_str(&warnings).unwrap_or_default(),
         plan: plan.and_then(|p| serde_json::from_str(&p).ok()),
+        cancel_requested: r.get::<_, i64>(14)? != 0,
+        attempts: r.get::<_, i64>(15)? as u32,
     })
 }
 
 impl Store {
+    /// Open (or create) the store; every error names the path it is about.
     pub fn open(dir: &Path) -> Result<Store> {
-        std::fs::create_dir_all(dir.join("jobs")).with_context(|| format!("create {}", dir.display()))?;
-        let db = Connection::open(dir.join("fluidbed.sqlite"))?;
-        db.pragma_update(None, "journal_mode", "WAL")?;
-        db.pragma_update(None, "synchronous", "NORMAL")?;
-        db.busy_timeout(std::time::Duration::from_secs(10))?;
-        db.execute_batch(SCHEMA)?;
-        Ok(Store { dir: dir.to_path_buf(), db: Mutex::new(db) })
+        let jobs = dir.join("jobs");
+        std::fs::create_dir_all(&jobs)
+            .with_context(|| format!("cannot create the data directory {}", jobs.display()))?;
+        let probe = dir.join(".write-probe");
+        std::fs::write(&probe, b"fluidbed")
+            .and_then(|_| std::fs::remove_file(&probe))
+            .with_context(|| format!("the data directory {} is not writable", dir.display()))?;
+        let path = dir.join("fluidbed.sqlite");
+        let open = || -> rusqlite::Result<Connection> {
+            let db = Connection::open(&path)?;
+            db.pragma_update(None, "journal_mode", "WAL")?;
+            db.pragma_update(None, "synchronous", "NORMAL")?;
+            db.busy_timeout(std::time::Duration::from_secs(10))?;
+            db.execute_batch(SCHEMA)?;
+            for (col, def) in ADDED_COLUMNS {
+                let has: bool =
+                    db.query_row("SELECT COUNT(*) > 0 FROM pragma_table_info('jobs') WHERE name = ?1", [col], |r| {
+                        r.get(0)
+                    })?;
+                if !has {
+                    db.execute_batch(&format!("ALTER TABLE jobs ADD COLUMN {col} {def}"))?;
+                }
+            }
+            Ok(db)
+        };
+        let db = open().with_context(|| format!("cannot open the job database {}", path.display()))?;
+        let store = Store { dir: dir.to_path_buf(), db: Mutex::new(db) };
+        store.restore_reserve();
+        Ok(store)
+    }
+
+    pub fn dir(&self) -> &Path {
+        &self.dir
+    }
+
+    fn reserve_path(&self) -> PathBuf {
+        self.dir.join("reserve.bin")
+    }
+    /// Set the reserve aside again (best effort: on a full disk it stays released).
+    pub fn restore_reserve(&self) {
+        let p = self.reserve_path();
+        if std::fs::metadata(&p).map(|m| m.len() as usize).ok() != Some(RESERVE_BYTES)
+            && write_atomic(&p, &vec![0u8; RESERVE_BYTES]).is_err()
+        {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
+    /// Free the reserve (after a failed write), so that the failure itself can be recorded.
+    pub fn release_reserve(&self) {
+        let _ = std::fs::remove_file(self.reserve_path());
+    }
+    pub fn reserve_held(&self) -> bool {
+        std::fs::metadata(self.reserve_path()).is_ok_and(|m| m.len() as usize == RESERVE_BYTES)
+    }
+
+    /// Fold the WAL into the database and close it (the last call on a store).
+    pub fn close(&self) -> Result<()> {
+        let mut db = self.db();
+        db.execute_batch("PRAGMA wal_checkpoint(TRUNCATE);")?;
+        let real = std::mem::replace(&mut *db, Connection::open_in_memory()?);
+        real.close().map_err(|(_, e)| e)?;
+        Ok(())
     }
 
     fn db(&self) -> std::sync::MutexGuard<'_, Connection> {
@@ -153,12 +221,28 @@ impl Store {
         Ok(ids)
     }
 
+    /// Mark running and count the attempt (a server stop gives it back with `release_attempt`;
+    /// a crash does not, so the count tells how often this job took a server down).
     pub fn set_running(&self, id: &str, now: &str) -> Result<()> {
         self.db().execute(
-            "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, ?2) WHERE id = ?1",
+            "UPDATE jobs SET status = 'running', started_at = COALESCE(started_at, ?2), attempts = attempts + 1 WHERE id = ?1",
             params![id, now],
         )?;
         Ok(())
+    }
+
+    /// A clean stop: this attempt did not crash the server.
+    pub fn release_attempt(&self, id: &str) -> Result<()> {
+        self.db().execute("UPDATE jobs SET attempts = MAX(attempts - 1, 0) WHERE id = ?1", [id])?;
+        Ok(())
+    }
+
+    /// Record a cancel request (it survives a restart); false if the job is already final.
+    pub fn request_cancel(&self, id: &str) -> Result<bool> {
+        let n = self
+            .db()
+            .execute("UPDATE jobs SET cancel_requested = 1 WHERE id = ?1 AND status IN ('queued', 'running')", [id])?;
+        Ok(n > 0)
     }
 
     /// What a running job is doing when that is not stepping (e.g. preparing its bed); None clears it.
@@ -199,7 +283,8 @@ impl Store {
     }
 
     pub fn put_snapshot(&self, id: &str, s: &Snapshot, info: &SnapshotInfo) -> Result<()> {
-        write_atomic(&self.snapshot_path(id, s.index), &bincode::serialize(s)?)?;
+        let path = self.snapshot_path(id, s.index);
+        write_atomic(&path, &bincode::serialize(s)?).with_context(|| format!("cannot write {}", path.display()))?;
         self.db().execute(
             "INSERT OR REPLACE INTO snapshots (job_id, n, time_s, step, pressure_drop_pa, mean_particle_height_m) VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
             params![id, info.n as i64, info.time_s, info.step as i64, info.pressure_drop_pa, info.mean_particle_height_m],
@@ -234,7 +319,8 @@ impl Store {
     }
 
     pub fn put_checkpoint(&self, id: &str, bytes: &[u8]) -> Result<()> {
-        write_atomic(&self.checkpoint_path(id), bytes)
+        let path = self.checkpoint_path(id);
+        write_atomic(&path, bytes).with_context(|| format!("cannot write {}", path.display()))
     }
 
     pub fn checkpoint(&self, id: &str) -> Result<Option<Vec<u8>>> {
@@ -248,16 +334,21 @@ impl Store {
 
 /// Write a file so that readers see the old content or the new one, never a part: write a
 /// temporary file in the same folder, fsync it, rename it over the target, fsync the folder.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = path.parent().context("file has a parent folder")?;
+/// On failure (a full disk) the temporary file is removed.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let dir = path.parent().ok_or_else(|| std::io::Error::other("file has no parent folder"))?;
     std::fs::create_dir_all(dir)?;
     let tmp = dir.join(format!(".{}.tmp", path.file_name().and_then(|n| n.to_str()).unwrap_or("file")));
-    {
+    let written = (|| {
         let mut f = std::fs::File::create(&tmp)?;
         f.write_all(bytes)?;
         f.sync_all()?;
+        std::fs::rename(&tmp, path)
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
     }
-    std::fs::rename(&tmp, path)?;
+    written?;
     if let Ok(d) = std::fs::File::open(dir) {
         let _ = d.sync_all();
     }

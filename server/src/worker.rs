@@ -10,6 +10,7 @@ use fluidbed_core::case::Case;
 use fluidbed_core::dem::solver_pool;
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::Simulation;
+use serde_json::json;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -59,7 +60,13 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                             let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_job(&app, &id)));
                             let error = match outcome {
                                 Ok(Ok(())) => None,
-                                Ok(Err(e)) => Some(format!("internal error: {e:#}")),
+                                Ok(Err(e)) => {
+                                    // Most likely a write that failed (a full or read-only disk):
+                                    // free the reserve so that the failure itself can be stored.
+                                    app.store.release_reserve();
+                                    app.health.write_failed(&format!("{e:#}"));
+                                    Some(format!("cannot store the job's results: {e:#}"))
+                                }
                                 Err(p) => Some(format!("the solver panicked: {}", panic_text(&*p))),
                             };
                             if let Some(msg) = error.filter(|_| !app.stopping()) {
@@ -81,19 +88,33 @@ fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
+/// End a job. Listeners get `status` and `end` even when the store cannot record it (a full
+/// disk), so that no client waits for ever.
 fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
     if app.stopping() {
         return;
     }
-    if let Ok(true) = app.store.finish(id, status, message, &now_rfc3339()) {
-        if let Ok(Some(job)) = app.store.get(id) {
-            app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
-            app.hub.publish(id, JobEvent::new("end", None, &job.status_json()));
+    let doc = match app.store.finish(id, status, message, &now_rfc3339()) {
+        Ok(true) => app.store.get(id).ok().flatten().map(|j| j.status_json()),
+        Ok(false) => None,
+        Err(e) => {
+            let msg = format!("cannot record that job {id} {}: {e:#}", status.as_str());
+            eprintln!("fluidbed-server: {msg}");
+            app.health.write_failed(&msg);
+            Some(json!({ "status": status.as_str(), "message": message }))
         }
+    };
+    if let Some(doc) = doc {
+        app.hub.publish(id, JobEvent::new("status", None, &doc));
+        app.hub.publish(id, JobEvent::new("end", None, &doc));
     }
     app.cancels.lock().unwrap_or_else(|e| e.into_inner()).remove(id);
     app.hub.close(id);
 }
+
+/// After this many starts that took the server down (a crash, an abort, a kill), a job is failed
+/// instead of resumed: it would take the next server down too.
+pub const MAX_CRASHES: u32 = 2;
 
 /// The cancel flag of a job (created on first use).
 pub fn cancel_flag(app: &App, id: &str) -> Arc<AtomicBool> {
@@ -106,9 +127,21 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
         return Ok(());
     }
     let cancel = cancel_flag(app, id);
+    if job.cancel_requested {
+        cancel.store(true, Ordering::SeqCst);
+    }
     if cancel.load(Ordering::SeqCst) {
-        finish(app, id, Status::Cancelled, Some("cancelled before it started"));
+        let when = if job.status == Status::Queued { "before it started" } else { "by request" };
+        finish(app, id, Status::Cancelled, Some(&format!("cancelled {when}")));
         return Ok(());
+    }
+    if job.attempts >= MAX_CRASHES {
+        let msg = format!(
+            "not resumed: the server stopped unexpectedly {} times while running this job (out of memory?); \
+             submit it again with a smaller case or a larger --max-job-memory",
+            job.attempts
+        );
+        return fail(app, id, &msg);
     }
     app.store.set_running(id, &now_rfc3339())?;
     if let Some(job) = app.store.get(id)? {
@@ -118,12 +151,16 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
     // Its own team lock, so that concurrent jobs each step DEM as a team (`team_step`).
     let pool = solver_pool().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
     let base_wall = job.wall_s;
-    pool.install(|| drive(app, id, &cancel, base_wall))
+    let out = pool.install(|| drive(app, id, &cancel, base_wall));
+    if app.stopping() && app.graceful() {
+        app.store.release_attempt(id)?;
+    }
+    out
 }
 
 /// Build or restore the simulation and step it to the end, a chunk at a time.
 fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Result<()> {
-    let started = Instant::now();
+    let prepared_from = Instant::now();
     let mut sim = match app.store.checkpoint(id)? {
         Some(bytes) => match Simulation::restore(&bytes) {
             Ok(s) => s,
@@ -138,7 +175,21 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             if preparing {
                 say(app, id, Some("preparing the bed: pouring and settling the particles (reused from the cache if this bed was made before)"))?;
             }
-            let sim = match Simulation::new(case, Some(&app.store.cache_dir())) {
+            // The pour stops at once on a cancel or a server stop (then Simulation::new finds
+            // the poured bed in the cache).
+            let stop = || cancel.load(Ordering::SeqCst) || app.stopping();
+            let cache = app.store.cache_dir();
+            if let Err(e) = fluidbed_core::dem::bed::build_bed_until(&case, Some(&cache), &stop) {
+                return if app.stopping() {
+                    Ok(())
+                } else if cancel.load(Ordering::SeqCst) {
+                    finish(app, id, Status::Cancelled, Some("cancelled by request while preparing the bed"));
+                    Ok(())
+                } else {
+                    fail(app, id, &format!("cannot prepare the bed: {e}"))
+                };
+            }
+            let sim = match Simulation::new(case, Some(&cache)) {
                 Ok(s) => s,
                 Err(e) => return fail(app, id, &e.to_string()),
             };
@@ -151,15 +202,22 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
     if app.stopping() {
         return Ok(());
     }
+    if cancel.load(Ordering::SeqCst) {
+        finish(app, id, Status::Cancelled, Some("cancelled by request"));
+        return Ok(());
+    }
     app.store.set_plan(id, &serde_json::to_value(sim.plan())?)?;
+    // The ETA's rate counts stepping only, not the preparation before it.
+    let started = Instant::now();
     let checkpoint_every = sim.case().outputs.checkpoint_interval_s;
     let mut last_checkpoint_t = sim.time();
     let (t_start, end) = (sim.time(), sim.end_time());
     let mut chunk: u64 = 10;
     let mut last_progress = Instant::now() - PROGRESS_EVERY;
+    let wall_before = base_wall + prepared_from.elapsed().as_secs_f64();
     while !sim.is_finished() {
         if app.stopping() {
-            return Ok(());
+            return stop_here(app, id, &sim);
         }
         if cancel.load(Ordering::SeqCst) {
             finish(app, id, Status::Cancelled, Some("cancelled by request"));
@@ -174,10 +232,12 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             Ok(s) => s,
             Err(e) => return fail(app, id, &e.to_string()),
         };
-        if app.stopping() {
+        // A crash-like stop writes nothing more; a graceful one stores this chunk's snapshot and
+        // checkpoints at the top of the loop.
+        if app.stopping() && !app.graceful() {
             return Ok(());
         }
-        let wall = base_wall + started.elapsed().as_secs_f64();
+        let wall = wall_before + started.elapsed().as_secs_f64();
         let rate = (sim.time() - t_start) / started.elapsed().as_secs_f64().max(1e-9);
         let eta = (rate > 0.0).then(|| (end - sim.time()).max(0.0) / rate);
         if let Some(s) = snap {
@@ -190,7 +250,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             };
             app.store.put_snapshot(id, &s, &info)?;
             if sim.time() - last_checkpoint_t >= checkpoint_every || sim.is_finished() {
-                if app.stopping() {
+                if app.stopping() && !app.graceful() {
                     return Ok(());
                 }
                 app.store.put_checkpoint(id, &sim.checkpoint())?;
@@ -216,6 +276,15 @@ fn say(app: &Arc<App>, id: &str, message: Option<&str>) -> Result<()> {
     app.store.set_message(id, message)?;
     if let Some(job) = app.store.get(id)? {
         app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+    }
+    Ok(())
+}
+
+/// A server stop: a graceful one checkpoints the state reached (the job resumes from here); a
+/// crash-like one (`Server::kill`) writes nothing more.
+fn stop_here(app: &Arc<App>, id: &str, sim: &Simulation) -> Result<()> {
+    if app.graceful() {
+        app.store.put_checkpoint(id, &sim.checkpoint())?;
     }
     Ok(())
 }

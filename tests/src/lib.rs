@@ -35,15 +35,51 @@ fn rand_u64() -> u64 {
     h.finish()
 }
 
-/// Start a server on 127.0.0.1:0 over `data_dir`.
-pub fn start(data_dir: &Path, token: Option<&str>) -> Server {
+/// The configuration `start` uses: 127.0.0.1:0 over `data_dir`, one worker of one thread.
+pub fn test_config(data_dir: &Path, token: Option<&str>) -> Config {
     let mut cfg = Config::new(data_dir.to_path_buf());
     cfg.listen = "127.0.0.1:0".parse().expect("addr");
     cfg.token = token.map(str::to_string);
     cfg.workers = 1;
     cfg.threads_per_job = 1;
     cfg.max_body_bytes = 256 * 1024;
-    Server::start(cfg).expect("server starts")
+    cfg
+}
+
+/// Start a server on 127.0.0.1:0 over `data_dir`.
+pub fn start(data_dir: &Path, token: Option<&str>) -> Server {
+    Server::start(test_config(data_dir, token)).expect("server starts")
+}
+
+/// A DEM-only case whose bed is poured from a seed (`settled_height_m` in a 44-mm column): the
+/// pour takes thousands of steps before the run's first one.
+pub fn poured_case(settled_height_m: f64, end_time_s: f64, snapshot_interval_s: f64) -> Value {
+    json!({
+        "name": "e2e poured bed",
+        "column": { "diameter_m": 0.044, "height_m": 0.12 },
+        "particles": { "diameter_m": D },
+        "bed": { "generated": { "settled_height_m": settled_height_m, "seed": 7 } },
+        "end_time_s": end_time_s,
+        "outputs": { "snapshot_interval_s": snapshot_interval_s, "fields": ["voidage"] },
+        "voidage": { "method": "direct" }
+    })
+}
+
+/// Poll a job until `pred` holds for it (or `timeout` passes); the last job document.
+pub async fn wait_until(
+    http: &reqwest::Client,
+    job_url: &str,
+    timeout: Duration,
+    pred: impl Fn(&Value) -> bool,
+) -> Value {
+    let t0 = Instant::now();
+    loop {
+        let j: Value = http.get(job_url).send().await.expect("get job").json().await.expect("job json");
+        if pred(&j) || t0.elapsed() > timeout {
+            return j;
+        }
+        tokio::time::sleep(Duration::from_millis(20)).await;
+    }
 }
 
 /// Diameter of the test particles.

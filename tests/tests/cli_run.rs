@@ -24,8 +24,8 @@ fn run_with_embedded_server_leaves_csv_npy_vtk_and_png() {
     for f in [
         "voidage_000000.npy",
         "voidage_000002.npy",
-        "cells_000002.vtk",
-        "particles_000002.vtk",
+        "cells_000002.vtu",
+        "particles_000002.vtp",
         "cells.pvd",
         "voidage_last.png",
         "mean_particle_height.png",
@@ -46,4 +46,49 @@ fn exit_codes_tell_invalid_case_and_unreachable_server_apart() {
     let code = fluidbed::cli::main_with(["fluidbed", "--server", "http://127.0.0.1:9", "status", "abc"]);
     assert_eq!(code, fluidbed::exit::SERVER);
     assert_eq!(fluidbed::cli::main_with(["fluidbed", "no-such-verb"]), fluidbed::exit::USAGE);
+}
+
+#[test]
+fn run_replaces_its_own_folder_refuses_others_and_folds_the_wal() {
+    let dir = TempDir::new("cli-out");
+    let case = dir.path().join("tiny.json");
+    std::fs::write(&case, lattice_case(3, 2, 0.01, 0.005).to_string()).unwrap();
+    let out = dir.path().join("out");
+    let run = |out: &std::path::Path| {
+        fluidbed::cli::main_with([
+            "fluidbed",
+            "run",
+            case.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+            "--threads",
+            "1",
+        ])
+    };
+    assert_eq!(run(&out), fluidbed::exit::OK);
+    // The .pvd series lists VTK XML files that exist.
+    let pvd = std::fs::read_to_string(out.join("cells.pvd")).unwrap();
+    assert!(pvd.contains("file=\"cells_000002.vtu\""), "{pvd}");
+    let vtu = std::fs::read(out.join("cells_000002.vtu")).unwrap();
+    assert!(vtu.starts_with(b"<?xml") && String::from_utf8_lossy(&vtu).contains("vtkZLibDataCompressor"));
+    // The embedded server folded its WAL into the database when it stopped.
+    let wal = out.join("server-data").join("fluidbed.sqlite-wal");
+    assert!(std::fs::metadata(&wal).map_or(true, |m| m.len() == 0), "WAL left: {wal:?}");
+
+    // A second run into the same folder leaves no stale file of the first.
+    std::fs::write(out.join("stale.npy"), b"old").unwrap();
+    assert_eq!(run(&out), fluidbed::exit::OK);
+    assert!(!out.join("stale.npy").exists());
+    assert!(out.join("pressure_drop.csv").is_file());
+
+    // A folder that `run` did not write is not touched.
+    let other = dir.path().join("mine");
+    std::fs::create_dir_all(&other).unwrap();
+    std::fs::write(other.join("thesis.tex"), b"keep me").unwrap();
+    assert_eq!(run(&other), fluidbed::exit::USAGE);
+    assert_eq!(std::fs::read(other.join("thesis.tex")).unwrap(), b"keep me");
+
+    // `fetch` refuses an id that would leave its output folder.
+    let code = fluidbed::cli::main_with(["fluidbed", "--server", "http://127.0.0.1:9", "fetch", "../../x"]);
+    assert_eq!(code, fluidbed::exit::USAGE);
 }

@@ -1,8 +1,10 @@
-//! Downloads: the snapshot list, one snapshot as json / npy / vtk / png, the pressure-drop series.
+//! Downloads: the snapshot list, one snapshot as json / npy / vtk (legacy) / vtu and vtp (VTK
+//! XML, what .pvd series list) / png, the pressure-drop series.
 //!
 //! npy arrays: a cell field (`field=voidage|pressure`) has shape [nz, cells_per_layer] in the
 //! grid's order (within a layer: annulus by annulus, n0·i² + j); `field=particles` has shape
-//! [N, 6]: x, y, z, vx, vy, vz per particle (m, m/s).
+//! [N, 6]: x, y, z, vx, vy, vz per particle (m, m/s); `field=gas_velocity` has shape
+//! [nz, cells_per_layer, 3]: the interstitial gas velocity (U_r, U_θ, U_z) per cell (m/s).
 
 use super::jobs::find;
 use super::problem::{internal, problem};
@@ -11,7 +13,7 @@ use axum::extract::{Path, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use fluidbed_core::output::{fields, npy, plot, vtk};
+use fluidbed_core::output::{fields, npy, plot, vtk, vtk_xml};
 use fluidbed_core::sim::snapshot::Snapshot;
 use serde::Deserialize;
 use serde_json::json;
@@ -109,6 +111,17 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             }
             None => missing("particles"),
         },
+        "npy" if what == "gas_velocity" => match &s.gas_velocity_m_s {
+            Some(u) => bytes(
+                "application/octet-stream",
+                format!("gas_velocity_{n:06}.npy"),
+                npy::encode_f64(
+                    &[grid.nz, grid.cells_per_layer(), 3],
+                    &u.iter().flatten().copied().collect::<Vec<_>>(),
+                ),
+            ),
+            None => missing("gas_velocity"),
+        },
         "npy" => match cell_field(s, what) {
             Some(f) => bytes(
                 "application/octet-stream",
@@ -126,6 +139,11 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             None => missing("particles"),
         },
         "vtk" => bytes("text/plain", format!("cells_{n:06}.vtk"), vtk::snapshot_cells(s).into_bytes()),
+        "vtp" | "vtu" if what == "particles" => match &s.particles {
+            Some(p) => bytes("application/xml", format!("particles_{n:06}.vtp"), vtk_xml::particles(p)),
+            None => missing("particles"),
+        },
+        "vtu" => bytes("application/xml", format!("cells_{n:06}.vtu"), vtk_xml::snapshot_cells(s)),
         "png" => match cell_field(s, what) {
             Some(f) => {
                 let (lo, hi) = if field_name == "voidage" { (0.3, 1.0) } else { min_max(&f) };
@@ -133,7 +151,7 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             }
             None => missing(what),
         },
-        _ => problem(StatusCode::BAD_REQUEST, "Unknown format", "format is one of json, npy, vtk, png"),
+        _ => problem(StatusCode::BAD_REQUEST, "Unknown format", "format is one of json, npy, vtk, vtu, vtp, png"),
     }
 }
 

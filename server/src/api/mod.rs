@@ -13,6 +13,7 @@ use axum::routing::get;
 use axum::{Json, Router};
 use problem::problem;
 use std::sync::Arc;
+use tower_http::timeout::{RequestBodyTimeoutLayer, TimeoutLayer};
 
 pub const OPENAPI: &str = include_str!("openapi.json");
 
@@ -31,11 +32,26 @@ pub fn router(app: Arc<App>) -> Router {
         .fallback(not_found)
         .layer(axum::middleware::from_fn_with_state(app.clone(), auth))
         .layer(DefaultBodyLimit::max(limit))
+        .layer(RequestBodyTimeoutLayer::new(app.config.body_read_timeout))
+        .layer(TimeoutLayer::with_status_code(StatusCode::REQUEST_TIMEOUT, app.config.request_timeout))
+        .layer(axum::middleware::from_fn(problem::errors_as_problems))
         .with_state(app)
 }
 
-async fn healthz() -> Json<serde_json::Value> {
-    Json(serde_json::json!({ "status": "ok", "version": env!("CARGO_PKG_VERSION") }))
+/// 200 while the data directory takes writes; 503 with the cause (a full or read-only disk).
+async fn healthz(State(app): State<Arc<App>>) -> Response {
+    let a = app.clone();
+    let (ok, data_dir) = match tokio::task::spawn_blocking(move || a.health.check(&a.store)).await {
+        Ok(r) => r,
+        Err(e) => return problem::internal(e.into()),
+    };
+    let body = serde_json::json!({
+        "status": if ok { "ok" } else { "degraded" },
+        "version": env!("CARGO_PKG_VERSION"),
+        "data_dir": data_dir,
+    });
+    let code = if ok { StatusCode::OK } else { StatusCode::SERVICE_UNAVAILABLE };
+    (code, Json(body)).into_response()
 }
 
 async fn schema() -> Json<serde_json::Value> {

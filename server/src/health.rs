@@ -1,0 +1,43 @@
+//! The data directory's health as `/healthz` reports it: the last write that failed (cleared by a
+//! later successful probe), whether the reserve (store.rs) is held, and a probe write.
+
+use crate::store::Store;
+use serde_json::{json, Value};
+use std::sync::Mutex;
+
+#[derive(Default)]
+pub struct Health {
+    last_write_error: Mutex<Option<String>>,
+}
+
+impl Health {
+    /// Remember a failed write (a full or read-only disk) until a probe succeeds again.
+    pub fn write_failed(&self, message: &str) {
+        *self.last_write_error.lock().unwrap_or_else(|e| e.into_inner()) = Some(message.to_string());
+    }
+
+    /// Probe the data directory; (healthy, the `data_dir` report). A successful probe sets the
+    /// reserve aside again and forgets an earlier failure.
+    pub fn check(&self, store: &Store) -> (bool, Value) {
+        let dir = store.dir();
+        let probe = dir.join(".health-probe");
+        let written = std::fs::write(&probe, [0u8; 4096]).and_then(|_| std::fs::remove_file(&probe));
+        let _ = std::fs::remove_file(&probe);
+        let mut last = self.last_write_error.lock().unwrap_or_else(|e| e.into_inner());
+        if written.is_ok() {
+            store.restore_reserve();
+            if store.reserve_held() {
+                *last = None;
+            }
+        }
+        let ok = written.is_ok() && store.reserve_held() && last.is_none();
+        let report = json!({
+            "path": dir.display().to_string(),
+            "writable": written.as_ref().map(|_| true).unwrap_or(false),
+            "probe_error": written.err().map(|e| format!("cannot write {}: {e}", probe.display())),
+            "reserve_held": store.reserve_held(),
+            "last_write_error": *last,
+        });
+        (ok, report)
+    }
+}
