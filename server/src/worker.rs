@@ -179,7 +179,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             // the poured bed in the cache).
             let stop = || cancel.load(Ordering::SeqCst) || app.stopping();
             let cache = app.store.cache_dir();
-            if let Err(e) = fluidbed_core::dem::bed::build_bed_until(&case, Some(&cache), &stop) {
+            if let Err(e) = fluidbed_core::dem::build_bed_until(&case, Some(&cache), &stop) {
                 return if app.stopping() {
                     Ok(())
                 } else if cancel.load(Ordering::SeqCst) {

@@ -91,6 +91,7 @@ pub fn build_bed_until(case: &Case, cache_dir: Option<&Path>, stop: Stop) -> Res
 
 /// Pour and settle; `observe`, if given, sees the system after every step with the
 /// contacts' Coulomb excess measured (`DemSystem::set_audit`; tests use it).
+#[cfg(test)]
 pub fn generate(
     case: &Case,
     count: Option<usize>,

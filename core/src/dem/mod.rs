@@ -42,7 +42,7 @@ mod work_split;
 #[cfg(test)]
 mod tests;
 
-pub use bed::{build_bed, fnv1a};
+pub use bed::{build_bed, build_bed_until, fnv1a, Stop, STOPPED};
 pub use contact::{ContactLaw, V3};
 pub use kernel::{Kernel, KERNEL_ENV};
 pub use system::DemSystem;
