@@ -6,6 +6,8 @@
 //!    dominant frequency and the time-averaged voidage (layer means; annulus means over the bed),
 //!    beside the noise floor: the same reference from a second poured bed (seed 2). An error below
 //!    the floor is inside the noise.
+//!    The costs are measured again interleaved in one process (`tradeoff_cost` lines), the figures
+//!    to compare. `-- tradeoff errors|cost|voidage` runs one part (the voidage part always runs).
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -13,7 +15,7 @@
 //! "paper_sg3_l1","paper_sg3_ns_per_particle"} (per DEM step: the default at its interval, the
 //! paper's square grid configuration 3 at every step).
 
-use crate::coupled::{shipped_case, state_at};
+use crate::coupled::{coupled_round, shipped_case, state_at, Tally};
 use fluidbed_core::case::{BoxSplit, Case, Voidage};
 use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
 use fluidbed_core::grid::CylGrid;
@@ -195,10 +197,42 @@ fn voidage_point(g: &CylGrid, a: f64, make: &dyn Fn() -> Box<dyn VoidageMethod>)
     (l1_sum / 3.0, ns_sum / 3.0)
 }
 
+/// Cost of each setting on the reference bed, interleaved in one process (rounds of 1,000 steps
+/// from the same state), so that the VM's speed swings fall on all settings alike: wall seconds
+/// per simulated second.
+fn interleaved_costs() {
+    let reference = bed(1);
+    let state = state_at(&reference, SPIN_UP_S, "tradeoff-seed1");
+    let mut exact = reference.clone();
+    exact.voidage = Voidage::ExactCylindrical;
+    let exact_state = state_at(&exact, SPIN_UP_S, "tradeoff-exact");
+    let mut runs: Vec<(String, Simulation, Tally)> = Vec::new();
+    for interval in [1u32, 2, 5, 10, 20] {
+        let mut sim = Simulation::restore(&state).expect("state");
+        sim.set_coupling_interval(interval);
+        runs.push((format!("coupling_interval {interval}"), sim, Tally::default()));
+    }
+    let sim = Simulation::restore(&exact_state).expect("state");
+    runs.push(("exact_cylindrical at the default interval".into(), sim, Tally::default()));
+    for _ in 0..6 {
+        for (_, sim, t) in runs.iter_mut() {
+            coupled_round(sim, 1000, t);
+        }
+    }
+    let dt = reference.dem.time_step_s;
+    for (label, _, t) in &runs {
+        println!("{}", json!({"bench": "tradeoff_cost", "setting": label, "wall_s_per_sim_s": t.per_step() / dt,
+            "stages_s_per_step": t.stages_json()}));
+    }
+}
+
 pub fn run() {
-    let skip_runs = std::env::args().nth(2).as_deref() == Some("voidage");
-    if !skip_runs {
+    let part = std::env::args().nth(2).unwrap_or_default();
+    if part.is_empty() || part == "errors" {
         coupled_front();
+    }
+    if part.is_empty() || part == "cost" {
+        interleaved_costs();
     }
     let case = shipped_case("bubbling-44mm.json");
     let mut g = fluid_grid(&case);

@@ -3,9 +3,11 @@
 //! A case without a `gas` section runs DEM alone.
 
 pub mod bounds;
+mod contact_law;
 pub mod strict_json;
 mod validate;
 
+pub use contact_law::ContactLawChoice;
 pub use validate::{Problem, Severity, ValidationReport};
 
 use schemars::JsonSchema;
@@ -125,6 +127,8 @@ pub struct Particles {
     pub sliding_friction: f64,
     pub normal_damping: Damping,
     pub tangential_damping: Damping,
+    /// The contact law by name (default: Hertz–Mindlin with Tsuji damping).
+    pub contact_law: ContactLawChoice,
 }
 
 impl Default for Particles {
@@ -137,6 +141,7 @@ impl Default for Particles {
             sliding_friction: 0.1,
             normal_damping: Damping::TsujiAlpha(0.02),
             tangential_damping: Damping::TsujiAlpha(1e-4),
+            contact_law: ContactLawChoice::HertzMindlin,
         }
     }
 }

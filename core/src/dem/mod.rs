@@ -1,6 +1,9 @@
-//! Soft-sphere DEM: Hertz + Tsuji contacts, tube wall, AB3 (paper section 2.1).
+//! Soft-sphere DEM: Hertz–Mindlin + Tsuji contacts (or a linear spring–dashpot), tube wall, AB3
+//! (paper section 2.1).
 //!
-//! - `contact`: the contact law (PHYSICS.md 2), one kernel for pairs and walls;
+//! - `contact`: the contact law (PHYSICS.md 2), one generic source for pairs (f32) and walls (f64);
+//! - `contact_styles`: the styles' springs and dashpots (Hertz–Mindlin, linear spring–dashpot);
+//! - `real`: the float types a law is evaluated in;
 //! - `integrator`: AB3 with a Heun/AB2 start (PHYSICS.md 7);
 //! - `ab_update`: the AB update on flat arrays (with the largest move, for positions);
 //! - `neighbors`: linked cells, cell-order sort, half Verlet list with contact history;
@@ -23,6 +26,7 @@ mod ab_update;
 mod batch;
 mod bed;
 mod contact;
+mod contact_styles;
 mod forces;
 mod integrator;
 mod kernel;
@@ -32,6 +36,7 @@ mod pair_batch;
 mod pair_scatter;
 mod pair_simd;
 mod particle_pass;
+mod real;
 mod steal_ranges;
 mod system;
 mod team_lock;
@@ -43,7 +48,7 @@ mod work_split;
 mod tests;
 
 pub use bed::{build_bed, build_bed_until, fnv1a, Stop, STOPPED};
-pub use contact::{ContactLaw, V3};
+pub use contact::{linear_damping_ratio, ContactLaw, ContactStyle, V3};
 pub use kernel::{Kernel, KERNEL_ENV};
 pub use system::DemSystem;
 pub use team_lock::solver_pool;

@@ -1,4 +1,4 @@
-//! The particle-particle contact law of `contact::contact_force`, evaluated for a batch of
+//! The particle-particle contact law of `contact::law_force`, evaluated for a batch of
 //! touching pairs at a time (PHYSICS.md 2.2-2.3), in single precision from double-precision
 //! positions, velocities and histories (see `lanes`; `pair_scatter` sums the forces). The lanes
 //! hold single-precision values only (each rounded once from the double it is formed in), so
@@ -11,7 +11,8 @@
 //! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
 use super::batch::{Batch, PairInputs, CAP};
-use super::contact::ContactLaw;
+use super::contact::{law_force, ContactLaw, ContactStyle, Style};
+use super::contact_styles::{HertzMindlin, LinearSpringDashpot};
 use super::kernel::Isa;
 use super::neighbors::Hist;
 #[cfg(target_arch = "x86_64")]
@@ -102,23 +103,27 @@ fn lane_max<T: Copy + PartialOrd>(n: usize, start: T, value: impl Fn(usize) -> T
     part.iter().fold(start, |a, &b| if b > a { b } else { a })
 }
 
-/// The contact law over lanes 0..m, no branches (the operations of `contact_force`), in single
-/// precision from double-precision inputs: the overlap comes from d² − r² taken in double,
+/// The contact law (`contact::law_force` of the law's style, in f32) over lanes 0..m, no
+/// branches, from double-precision inputs: the overlap comes from d² − r² taken in double,
 /// δ = (d² − r²)/(d + |r|), so it keeps ~1e-7 relative accuracy however small it is, and every
-/// force, torque and history is within ~1.5e-6 of the double law (test `batch_kernel`); 4–11%
-/// faster steps (docs/BENCHMARKS.md, "Single precision where it costs nothing that matters").
-/// Every array the loop reads or writes is single precision: with double arrays in the loop the
-/// compiler sized its vectors by them (eight lanes per step); now it takes sixteen ("Sixteen
-/// lanes, not eight"). All kernel variants do the same IEEE operations (no FMA), so they give
-/// the same bits. AUDIT also fills each lane's Coulomb excess (a division; tests only).
+/// force, torque and history is within ~1.5e-6 of the double law (test `batch_kernel`).
+/// Every array the loop reads or writes is single precision, so the compiler takes sixteen
+/// lanes per AVX-512 vector (docs/BENCHMARKS.md). All kernel variants do the same IEEE
+/// operations (no FMA), so they give the same bits. AUDIT also fills each lane's Coulomb excess.
 #[inline(always)]
 fn lanes<const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
+    match law.style {
+        ContactStyle::HertzMindlin => lanes_of::<HertzMindlin, FR, AUDIT>(b, law, d, h),
+        ContactStyle::LinearSpringDashpot => lanes_of::<LinearSpringDashpot, FR, AUDIT>(b, law, d, h),
+    }
+}
+
+#[inline(always)]
+fn lanes_of<S: Style, const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: f64, h: f64) {
     // Whole vectors of 16: the lanes past b.m hold scratch (zeros or older pairs) whose results
-    // nobody reads. A count of b.m left the compiler a scalar tail of lanes per batch, each
-    // several times the cost of a vector lane (docs/BENCHMARKS.md, "The lane loop's scalar tail").
+    // nobody reads; a count of b.m would leave a scalar tail of lanes per batch.
     let m = ((b.m.min(CAP) + 15) & !15).min(CAP);
-    let (kn, dn, ktl, dtl, mu, nt) =
-        (law.kn as f32, law.dn as f32, law.kt as f32, law.dt as f32, law.mu as f32, law.no_tension);
+    let c = law.coeffs::<f32>();
     let (d1, h) = (d as f32, h as f32);
     for l in 0..m {
         let dist = b.r2[l].sqrt();
@@ -126,51 +131,22 @@ fn lanes<const FR: bool, const AUDIT: bool>(b: &mut Batch, law: &ContactLaw, d: 
         let n = [b.dx[0][l] * inv, b.dx[1][l] * inv, b.dx[2][l] * inv];
         let delta = b.gap2[l] / (d1 + dist);
         b.delta[l] = delta;
-        let sd = delta.sqrt();
-        let qd = sd.sqrt(); // δ^{1/4} without powf
         let vr = [b.vrel[0][l], b.vrel[1][l], b.vrel[2][l]];
-        let vn = vr[0] * n[0] + vr[1] * n[1] + vr[2] * n[2];
-        // F_n = K_n δ^{3/2} + α_n √(m* K_n) δ^{1/4} dδ/dt (PHYSICS.md 2.2)
-        let fnorm = kn * delta * sd + dn * qd * vn;
-        let fnorm = if nt { fnorm.max(0.0) } else { fnorm };
-        let mut f = [-fnorm * n[0], -fnorm * n[1], -fnorm * n[2]];
-        if FR {
-            let ws = [b.ws[0][l], b.ws[1][l], b.ws[2][l]];
-            // Slip velocity v_ij − (v_ij·n)n + (R_i ω_i + R_j ω_j) × n (PHYSICS.md 2.3)
-            let wn = [ws[1] * n[2] - ws[2] * n[1], ws[2] * n[0] - ws[0] * n[2], ws[0] * n[1] - ws[1] * n[0]];
-            let vt = [vr[0] - vn * n[0] + wn[0], vr[1] - vn * n[1] + wn[1], vr[2] - vn * n[2] + wn[2]];
-            let s0 = [b.s[0][l], b.s[1][l], b.s[2][l]];
-            let mut s = [s0[0] + vt[0] * h, s0[1] + vt[1] * h, s0[2] + vt[2] * h];
-            let sn = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
-            s = [s[0] - sn * n[0], s[1] - sn * n[1], s[2] - sn * n[2]];
-            let kt = ktl * sd;
-            let et = dtl * qd;
-            let ft0 = [-kt * s[0] - et * vt[0], -kt * s[1] - et * vt[1], -kt * s[2] - et * vt[2]];
-            let ft2 = ft0[0] * ft0[0] + ft0[1] * ft0[1] + ft0[2] * ft0[2];
-            let lim = mu * fnorm.abs();
-            // Coulomb: |F_t| = μ F_n, damping dropped, ξ reset to match the spring alone.
-            let slide = ft2 > lim * lim;
-            let qs = lim / (ft2.sqrt() * kt); // one division, as `contact_force`
-            let scale = qs * kt;
-            let mut ft = ft0;
-            for q in 0..3 {
-                let scaled = ft0[q] * scale;
-                ft[q] = if slide { scaled } else { ft0[q] };
-                let reset = -ft0[q] * qs;
-                b.s[q][l] = if slide { reset } else { s[q] };
-                f[q] += ft[q];
-            }
-            b.c[0][l] = n[1] * ft[2] - n[2] * ft[1];
-            b.c[1][l] = n[2] * ft[0] - n[0] * ft[2];
-            b.c[2][l] = n[0] * ft[1] - n[1] * ft[0];
-            if AUDIT {
-                // Relative, in the lanes (a division per lane in double had cost 2% of a step).
-                let lim2 = lim * lim;
-                b.excess[l] = (ft[0] * ft[0] + ft[1] * ft[1] + ft[2] * ft[2] - lim2) / lim2.max(f32::MIN_POSITIVE);
+        let (ws, s0) = if FR {
+            ([b.ws[0][l], b.ws[1][l], b.ws[2][l]], [b.s[0][l], b.s[1][l], b.s[2][l]])
+        } else {
+            ([0.0; 3], [0.0; 3])
+        };
+        let out = law_force::<S, f32, FR, AUDIT>(&c, delta, n, vr, ws, s0, h);
+        for q in 0..3 {
+            b.f[q][l] = out.f[q];
+            if FR {
+                b.c[q][l] = out.c[q];
+                b.s[q][l] = out.s[q];
             }
         }
-        for (q, fq) in f.into_iter().enumerate() {
-            b.f[q][l] = fq;
+        if AUDIT {
+            b.excess[l] = out.excess;
         }
     }
 }

@@ -20,7 +20,8 @@ use std::path::Path;
 /// First bytes of a checkpoint, then the format number (u32, little-endian), then the state.
 const CHECKPOINT_MAGIC: &[u8; 8] = b"FLUIDBED";
 /// Bumped whenever the serialised state changes shape (format 2: the DEM's near list; 3: its
-/// contact histories in single precision; 4: the plan's gas step and coupling interval).
+/// contact histories in single precision; 4: the plan's gas step and coupling interval, the
+/// contact law's style).
 const CHECKPOINT_FORMAT: u32 = 4;
 
 #[derive(Debug, Clone, PartialEq)]
