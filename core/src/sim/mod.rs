@@ -1,6 +1,7 @@
 //! The simulation: owns the state (particles, gas, coupling buffers), follows the plan, runs the
 //! step loop with its watchdog, and produces snapshots and checkpoints.
 
+mod checkpoint;
 mod coupled;
 pub mod plan;
 pub mod snapshot;
@@ -17,12 +18,9 @@ use crate::grid::CylGrid;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// First bytes of a checkpoint, then the format number (u32, little-endian), then the state.
-const CHECKPOINT_MAGIC: &[u8; 8] = b"FLUIDBED";
-/// Bumped whenever the serialised state changes shape (format 2: the DEM's near list; 3: its
-/// contact histories in single precision; 4: the plan's gas step and coupling interval, the
-/// contact law's style).
-const CHECKPOINT_FORMAT: u32 = 4;
+/// The checkpoint format this build writes and reads (`checkpoint`: a self-describing header,
+/// then named sections).
+pub const CHECKPOINT_FORMAT: u32 = checkpoint::FORMAT;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum SimError {
@@ -206,32 +204,14 @@ impl Simulation {
         Ok(())
     }
 
-    /// The complete state behind a format header; `restore` continues bit-identically.
+    /// The complete state behind a self-describing header (`checkpoint`); `restore` continues
+    /// bit-identically.
     pub fn checkpoint(&self) -> Vec<u8> {
-        let mut out = CHECKPOINT_MAGIC.to_vec();
-        out.extend_from_slice(&CHECKPOINT_FORMAT.to_le_bytes());
-        bincode::serialize_into(&mut out, &self.st).expect("state serialises");
-        out
+        checkpoint::encode(&self.st)
     }
 
     pub fn restore(bytes: &[u8]) -> Result<Simulation, SimError> {
-        let body = match bytes.strip_prefix(CHECKPOINT_MAGIC) {
-            Some(rest) if rest.len() >= 4 => {
-                let format = u32::from_le_bytes(rest[..4].try_into().expect("four bytes"));
-                if format != CHECKPOINT_FORMAT {
-                    return Err(SimError::Checkpoint(format!(
-                        "written in checkpoint format {format}, this build reads format {CHECKPOINT_FORMAT}; rerun the case or resume it with the fluidbed version that wrote it"
-                    )));
-                }
-                &rest[4..]
-            }
-            _ => {
-                return Err(SimError::Checkpoint(
-                    "not a fluidbed checkpoint, or one from a version before checkpoint formats (November 2026); rerun the case".into(),
-                ))
-            }
-        };
-        let st: State = bincode::deserialize(body).map_err(|e| SimError::Checkpoint(e.to_string()))?;
+        let st = checkpoint::decode(bytes).map_err(SimError::Checkpoint)?;
         let grid = fluid_grid(&st.case);
         let mut sim = Simulation::assemble(st, grid);
         sim.refresh_voidage_field();

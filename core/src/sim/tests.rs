@@ -90,12 +90,9 @@ fn checkpoint_restore_continues_bit_identically() {
     let mut other = bytes.clone();
     other[8] ^= 0x40;
     let refused = |b: &[u8]| Simulation::restore(b).err().map(|e| e.to_string()).unwrap_or_default();
-    let want = format!(
-        "checkpoint format {}, this build reads format {}",
-        super::CHECKPOINT_FORMAT ^ 0x40,
-        super::CHECKPOINT_FORMAT
-    );
-    assert!(refused(&other).contains(&want), "{}", refused(&other));
+    let (f, g) = (super::CHECKPOINT_FORMAT ^ 0x40, super::CHECKPOINT_FORMAT);
+    assert!(refused(&other).contains(&format!("checkpoint format {f}")), "{}", refused(&other));
+    assert!(refused(&other).contains(&format!("reads format {g}")), "{}", refused(&other));
     assert!(refused(&bytes[8..]).contains("not a fluidbed checkpoint"), "{}", refused(&bytes[8..]));
     let mut c = Simulation::restore(&bytes).unwrap();
     c.run(&mut part).unwrap();
