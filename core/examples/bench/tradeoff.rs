@@ -221,8 +221,11 @@ fn interleaved_costs() {
     }
     let dt = reference.dem.time_step_s;
     for (label, _, t) in &runs {
-        println!("{}", json!({"bench": "tradeoff_cost", "setting": label, "wall_s_per_sim_s": t.per_step() / dt,
-            "stages_s_per_step": t.stages_json()}));
+        println!(
+            "{}",
+            json!({"bench": "tradeoff_cost", "setting": label, "wall_s_per_sim_s": t.per_step() / dt,
+            "stages_s_per_step": t.stages_json()})
+        );
     }
 }
 
