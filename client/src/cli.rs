@@ -1,13 +1,15 @@
 //! The command line: verbs map one-to-one to the HTTP API; `run` = submit + watch + fetch.
 
-use crate::api::{Api, ApiError};
+use crate::api::Api;
 use crate::exit;
 use crate::fetch::{fetch, Formats};
+use crate::outcome::{api_fail, fail, outcome_code, report_outcome};
+use crate::validate::validate;
 use crate::watch::watch;
 use clap::{Parser, Subcommand};
 use serde_json::{json, Value};
 use std::ffi::OsString;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 #[derive(Parser)]
 #[command(name = "fluidbed", version, about = "Run and fetch fluidbed DEM-CFD jobs", after_help = EXIT_HELP)]
@@ -89,61 +91,6 @@ pub fn main_with<I: IntoIterator<Item = T>, T: Into<OsString> + Clone>(args: I) 
     rt.block_on(dispatch(cli))
 }
 
-pub(crate) fn fail(code: i32, msg: &str) -> i32 {
-    eprintln!("fluidbed: {msg}");
-    code
-}
-
-pub(crate) fn api_fail(e: ApiError, json_out: bool) -> i32 {
-    match &e {
-        ApiError::Invalid(p) => {
-            if json_out {
-                println!("{p}");
-            } else {
-                for err in p["errors"].as_array().into_iter().flatten() {
-                    eprintln!(
-                        "error: {}: {} (got {}; allowed: {})",
-                        err["pointer"].as_str().unwrap_or(""),
-                        err["message"].as_str().unwrap_or(""),
-                        err["value"],
-                        err["allowed"].as_str().unwrap_or("")
-                    );
-                }
-            }
-            exit::INVALID_CASE
-        }
-        ApiError::Server(m) => fail(exit::SERVER, m),
-    }
-}
-
-/// Local validation: (exit code, case JSON text when valid).
-pub(crate) fn validate(path: &Path, json_out: bool) -> (i32, Option<(String, String)>) {
-    let text = match std::fs::read_to_string(path) {
-        Ok(t) => t,
-        Err(e) => return (fail(exit::INVALID_CASE, &format!("cannot read {}: {e}", path.display())), None),
-    };
-    match fluidbed_core::case::Case::parse_str(&text) {
-        Ok((case, report)) => {
-            if json_out {
-                println!("{}", json!({ "valid": true, "warnings": report.warnings }));
-            }
-            for w in &report.warnings {
-                eprintln!("warning: {w}");
-            }
-            (exit::OK, Some((text, case.name)))
-        }
-        Err(report) => {
-            if json_out {
-                println!("{}", json!({ "valid": false, "errors": report.errors, "warnings": report.warnings }));
-            }
-            for e in &report.errors {
-                eprintln!("error: {e}");
-            }
-            (exit::INVALID_CASE, None)
-        }
-    }
-}
-
 fn print_job(j: &Value, json_out: bool) {
     if json_out {
         println!("{j}");
@@ -161,14 +108,6 @@ fn print_job(j: &Value, json_out: bool) {
             j["wall_time_s"].as_f64().unwrap_or(0.0),
             j["name"].as_str().unwrap_or("")
         );
-    }
-}
-
-pub(crate) fn outcome_code(status: &str) -> i32 {
-    if status == "succeeded" {
-        exit::OK
-    } else {
-        exit::JOB_FAILED
     }
 }
 
@@ -259,14 +198,5 @@ async fn dispatch(cli: Cli) -> i32 {
         Verb::Run { case, out, formats, threads } => {
             crate::cli_run::run(cli.server.is_some().then_some(api), token, case, out, formats, threads, j).await
         }
-    }
-}
-
-pub(crate) fn report_outcome(id: &str, status: &str, message: Option<&str>, json_out: bool) {
-    if json_out {
-        println!("{}", json!({ "id": id, "status": status, "message": message }));
-    } else {
-        let m = message.map(|m| format!(": {m}")).unwrap_or_default();
-        eprintln!("job {id} {status}{m}");
     }
 }

@@ -3,9 +3,10 @@
 //! talks to it over HTTP like to any other server.
 
 use crate::api::Api;
-use crate::cli::{api_fail, fail, outcome_code, report_outcome, validate};
 use crate::exit;
 use crate::fetch::{fetch, Formats};
+use crate::outcome::{api_fail, fail, outcome_code, report_outcome};
+use crate::validate::validate;
 use crate::watch::watch;
 use serde_json::json;
 use std::path::PathBuf;

@@ -6,6 +6,8 @@ pub mod api;
 pub mod cli;
 mod cli_run;
 pub mod fetch;
+mod outcome;
+mod validate;
 pub mod watch;
 
 /// Exit codes: what a script can tell apart.

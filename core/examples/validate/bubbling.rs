@@ -109,7 +109,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
 pub fn run() -> serde_json::Value {
     let r = run_to(end_s());
     let case = case();
-    let (weight, head) = crate::fluidized::expected_dp(&case, r.particles);
+    let (weight, head) = expected_dp(&case, r.particles);
     let want = weight + head;
     let tail: Vec<f64> = r.dp.iter().filter(|(t, _)| *t >= 0.4).map(|x| x.1).collect();
     let mean = tail.iter().sum::<f64>() / tail.len() as f64;

@@ -118,3 +118,12 @@ pub fn timed_case(path: &str) -> serde_json::Value {
         "last_dp_pa": snaps.last().and_then(|s| s.pressure_drop_pa),
         "last_layer_pressure_pa": snaps.last().and_then(|s| s.pressure_pa.as_ref().map(|p| layers(s, p)))})
 }
+
+/// What the pressure drop of a fluidized bed should be: the bed weight per area less buoyancy
+/// (PHYSICS.md 10) and, since ΔP is read from the plate to z = (nz − 1) dz
+/// (`analysis::bed_pressure_drop`), the hydrostatic head ρ_g g z of the gas between the points.
+pub fn expected_dp(case: &fluidbed_core::case::Case, particles: usize) -> (f64, f64) {
+    let rho_g = case.gas.as_ref().expect("gas section").outlet_density_kg_m3();
+    let grid = fluidbed_core::sim::fluid_grid(case);
+    (bed_weight_per_area(case, particles, rho_g), rho_g * case.gravity_m_s2 * (grid.nz - 1) as f64 * grid.dz)
+}

@@ -5,7 +5,7 @@
 //! t = 0.4 s (after the 240-ms ramp and the first bubbles). It also prints the particles' momentum
 //! budget over the same window: weight = gas force + plate + tube − d(momentum)/dt.
 
-use crate::common::bed_weight_per_area;
+use crate::common::expected_dp;
 use serde_json::json;
 
 pub fn run() -> serde_json::Value {
@@ -36,13 +36,4 @@ pub fn run() -> serde_json::Value {
         crate::plots::series_with_level(&plate_series, plate, "docs/img/fluidized_plate_share.png");
     }
     out
-}
-
-/// What the pressure drop of a fluidized bed should be: the bed weight per area less buoyancy
-/// (PHYSICS.md 10) and, since ΔP is read from the plate to z = (nz − 1) dz
-/// (`analysis::bed_pressure_drop`), the hydrostatic head ρ_g g z of the gas between the points.
-pub fn expected_dp(case: &fluidbed_core::case::Case, particles: usize) -> (f64, f64) {
-    let rho_g = case.gas.as_ref().expect("gas section").outlet_density_kg_m3();
-    let grid = fluidbed_core::sim::fluid_grid(case);
-    (bed_weight_per_area(case, particles, rho_g), rho_g * case.gravity_m_s2 * (grid.nz - 1) as f64 * grid.dz)
 }

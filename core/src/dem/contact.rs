@@ -4,7 +4,7 @@
 //! spring–dashpot) and both float types: the pair lanes run it in f32 (`pair_batch`), walls in
 //! f64. A new contact model (rolling friction, cohesion) goes into `law_force` or a new `Style`.
 
-use super::contact_styles::{HertzMindlin, LinearSpringDashpot};
+use super::contact_styles::{Coeffs, HertzMindlin, LinearSpringDashpot, Style};
 use super::real::Real;
 use crate::case::{Case, ContactLawChoice, Damping};
 use serde::{Deserialize, Serialize};
@@ -104,30 +104,6 @@ impl ContactLaw {
 pub fn linear_damping_ratio(e: f64) -> f64 {
     let l = e.ln();
     -l / (std::f64::consts::PI.powi(2) + l * l).sqrt()
-}
-
-/// `ContactLaw`'s prefactors in the float type F.
-#[derive(Clone, Copy)]
-pub(crate) struct Coeffs<F> {
-    pub kn: F,
-    pub dn: F,
-    pub kt: F,
-    pub dt: F,
-    pub mu: F,
-    pub no_tension: bool,
-}
-
-/// Springs and dashpots of a style at overlap δ: F_n = elastic + η_n dδ/dt, F_t = −k_t ξ − η_t v_t.
-pub(crate) struct Stiffness<F> {
-    pub elastic: F,
-    pub eta_n: F,
-    pub kt: F,
-    pub eta_t: F,
-}
-
-/// A contact style: its springs and dashpots at an overlap (`contact_styles`).
-pub(crate) trait Style {
-    fn stiffness<F: Real>(c: &Coeffs<F>, delta: F) -> Stiffness<F>;
 }
 
 /// One contact evaluated in F: force on i, n × F_t, the new history, the Coulomb excess.

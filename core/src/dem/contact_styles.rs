@@ -1,7 +1,31 @@
-//! The springs and dashpots of each contact style at an overlap δ (`contact::Style`).
+//! The springs and dashpots of each contact style at an overlap δ (`Style`), which the one
+//! contact law (`contact::law_force`) is generic over.
 
-use super::contact::{Coeffs, Stiffness, Style};
 use super::real::Real;
+
+/// `ContactLaw`'s prefactors in the float type F.
+#[derive(Clone, Copy)]
+pub(crate) struct Coeffs<F> {
+    pub kn: F,
+    pub dn: F,
+    pub kt: F,
+    pub dt: F,
+    pub mu: F,
+    pub no_tension: bool,
+}
+
+/// Springs and dashpots of a style at overlap δ: F_n = elastic + η_n dδ/dt, F_t = −k_t ξ − η_t v_t.
+pub(crate) struct Stiffness<F> {
+    pub elastic: F,
+    pub eta_n: F,
+    pub kt: F,
+    pub eta_t: F,
+}
+
+/// A contact style: its springs and dashpots at an overlap.
+pub(crate) trait Style {
+    fn stiffness<F: Real>(c: &Coeffs<F>, delta: F) -> Stiffness<F>;
+}
 
 /// Hertz normal spring K_n δ^{3/2} with Tsuji damping α_n √(m* K_n) δ^{1/4}; Mindlin tangential
 /// spring K_t δ^{1/2} with damping α_t √(m* K_t) δ^{1/4} (PHYSICS.md 2.2–2.3).

@@ -19,7 +19,8 @@
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
 //! - `team_step`, `steal_ranges`: both passes of a step as one team of threads sharing the work;
 //! - `team_lock`: one team per pool at a time; `solver_pool` builds a pool with its own;
-//! - `system`: `DemSystem`, the state and the step loop;
+//! - `system`: `DemSystem`, the state; `step`: the step loop; `list_upkeep`: the lists' refresh
+//!   and rebuild; `diagnostics`: energies, loads, counters;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
 
 mod ab_update;
@@ -27,9 +28,11 @@ mod batch;
 mod bed;
 mod contact;
 mod contact_styles;
+mod diagnostics;
 mod forces;
 mod integrator;
 mod kernel;
+mod list_upkeep;
 mod near_list;
 mod neighbors;
 mod pair_batch;
@@ -38,6 +41,7 @@ mod pair_simd;
 mod particle_pass;
 mod real;
 mod steal_ranges;
+mod step;
 mod system;
 mod team_lock;
 mod team_step;

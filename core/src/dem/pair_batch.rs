@@ -11,8 +11,8 @@
 //! and an add by itself, so every variant does the same IEEE operations and gives the same bits.
 
 use super::batch::{Batch, PairInputs, CAP};
-use super::contact::{law_force, ContactLaw, ContactStyle, Style};
-use super::contact_styles::{HertzMindlin, LinearSpringDashpot};
+use super::contact::{law_force, ContactLaw, ContactStyle};
+use super::contact_styles::{HertzMindlin, LinearSpringDashpot, Style};
 use super::kernel::Isa;
 use super::neighbors::Hist;
 #[cfg(target_arch = "x86_64")]

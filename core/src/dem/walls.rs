@@ -45,7 +45,7 @@ impl WallList {
     }
 }
 
-/// One wall contact of a particle moving at (v, ω) = `motion`: overlap `delta` along the outward
+/// One wall contact of a particle with velocity and spin (v, ω): overlap `delta` along the outward
 /// normal `nrm`, the particle-wall law of `p`; hands wall `k`'s force and n × F_t to `on`.
 /// Returns (overlap, Coulomb excess, −∞ unless `p.audit`) for the diagnostics.
 #[inline(always)]

@@ -1,0 +1,82 @@
+//! Keeping the neighbour lists valid as the particles move: the near list redrawn from the
+//! Verlet list, the Verlet list rebuilt (with a re-sort by cell and the contact histories
+//! carried by particle id) when a particle could have moved past its skin (`near_list`).
+
+use super::contact::{dist2, V3};
+use super::near_list::Histories;
+use super::neighbors::{build_list, cell_order};
+use super::system::DemSystem;
+use super::walls::WallList;
+use rayon::prelude::*;
+
+impl DemSystem {
+    /// Redraw the near list from the Verlet list, rebuilding that first if a particle has moved
+    /// far enough since its build that it might miss a pair closer than d + near gap.
+    pub(super) fn refresh(&mut self) {
+        let reach = self.p.outer_move();
+        let moved = self.x.iter().zip(&self.x_build).any(|(&a, &b)| dist2(a, b) > reach * reach);
+        if moved {
+            self.rebuild_due = true;
+            return;
+        }
+        let (spare, code) = &mut self.spare;
+        spare.select_into(
+            &self.outer,
+            &self.x,
+            2.0 * self.p.radius,
+            self.p.near_gap(),
+            Histories::Near(&self.near),
+            code,
+        );
+        std::mem::swap(&mut self.near, spare);
+        self.sc.bounds.clear(); // replanned for the new list at the next step
+        self.x_near.clone_from(&self.x);
+        self.moved_bound = 0.0;
+        self.builds.1 += 1;
+    }
+
+    /// The displacement bound and the largest displacement since the last refresh (tests).
+    #[cfg(test)]
+    pub(super) fn moved_bound_and_largest(&self) -> (f64, f64) {
+        (self.moved_bound, self.largest_disp2().sqrt())
+    }
+
+    /// The largest squared displacement since the last refresh (as the particle pass measures it).
+    pub(super) fn largest_disp2(&self) -> f64 {
+        self.x.par_iter().zip(&self.x_near).map(|(&a, &b)| dist2(a, b)).reduce(|| 0.0, f64::max)
+    }
+
+    /// Re-sort particles by linked cell, rebuild the Verlet list, carry contact history by id,
+    /// draw the near list.
+    pub(super) fn rebuild(&mut self) {
+        let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
+        let perm = |src: &Vec<V3>| -> Vec<V3> { order.iter().map(|&o| src[o as usize]).collect() };
+        self.x = perm(&self.x);
+        self.v = perm(&self.v);
+        self.w = perm(&self.w);
+        if !self.ext.is_empty() {
+            self.ext = perm(&self.ext);
+        }
+        self.past.permute(&order);
+        let old_ids = std::mem::take(&mut self.ids);
+        self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
+        let diameter = 2.0 * self.p.radius;
+        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
+        if self.p.friction {
+            nl.carry_history(&self.near.list, &old_ids, &self.ids);
+        }
+        let (spare, code) = &mut self.spare;
+        spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, code);
+        std::mem::swap(&mut self.near, spare);
+        (nl.shear, nl.touch) = (Vec::new(), Vec::new());
+        self.outer = nl;
+        let had_walls = !self.x_build.is_empty();
+        self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
+        self.sc.bounds.clear(); // replanned for the new list at the next step
+        self.x_build.clone_from(&self.x);
+        self.x_near.clone_from(&self.x);
+        self.moved_bound = 0.0;
+        self.rebuild_due = false;
+        self.builds.0 += 1;
+    }
+}

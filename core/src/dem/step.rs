@@ -1,0 +1,164 @@
+//! The DEM step loop. A step is: pair pass over the near list → fused particle pass (walls,
+//! gravity, external force, AB update; both passes run by one team of threads, `team_step`) →
+//! near-list refresh when any particle moved more than about half the near gap, with a
+//! Verlet-list rebuild and re-sort first if the list could miss a near pair (`list_upkeep`).
+//! The first step after a start or a change of parameters is Heun's (PHYSICS.md 7).
+
+use super::contact::V3;
+use super::forces::{pair_pass, Acc, Stats};
+use super::integrator::weights;
+use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
+use super::system::DemSystem;
+use super::team_lock::TeamLock;
+use super::team_step::{team_step, StepState};
+
+impl DemSystem {
+    /// One DEM step of the case's time step (uses the current rayon pool).
+    pub fn step(&mut self) {
+        let team = TeamLock::try_take();
+        self.step_with(team.as_ref());
+    }
+
+    /// One step; with the team lock (held by the caller) the pair and particle passes run as
+    /// one team of threads (`team_step`), without it as two parallel loops (another system
+    /// holds the team: nested or concurrent use of the pool). The same bits either way.
+    pub fn step_with(&mut self, team: Option<&TeamLock>) {
+        if !self.frozen && !self.x.is_empty() {
+            if self.p.friction {
+                self.advance::<true>(team);
+            } else {
+                self.advance::<false>(team);
+            }
+        }
+        self.steps += 1;
+        self.time += self.p.dt;
+    }
+
+    pub(super) fn advance<const FR: bool>(&mut self, team: Option<&TeamLock>) {
+        let chunks = if self.p.work_chunks > 0 { self.p.work_chunks } else { 2 * rayon::current_num_threads() };
+        if self.sc.bounds.is_empty() || self.sc_threads != chunks {
+            self.sc.replan(&self.near.list, self.x.len(), chunks);
+            self.sc_threads = chunks;
+        }
+        let limit = self.p.near_move();
+        let refresh_disp2 = limit * limit;
+        // Measure exactly when the bound, grown by twice the last step's move, could pass the
+        // limit; a step whose move exceeds that is measured after it (below).
+        let safe = limit * (1.0 - 1e-9);
+        let exact = self.levels == 0 || self.moved_bound + 2.0 * SQRT_3 * self.last_move >= safe;
+        let x_ref = if exact { &self.x_near[..] } else { &[] };
+        let st = if self.levels == 0 {
+            let st1 =
+                pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
+            let st = st1.max(self.heun::<FR>());
+            self.sc.bounds.clear(); // replanned at the next step, now with the contacts' flags
+            st
+        } else {
+            let h = self.p.dt;
+            let b = weights(self.levels);
+            let step = Weights { hb: [h * b[0], h * b[1], h * b[2]], ring: self.ring as usize };
+            let st = match team {
+                Some(_) => {
+                    let s = StepState {
+                        x: &mut self.x,
+                        v: &mut self.v,
+                        w: &mut self.w,
+                        past: &mut self.past,
+                        walls: &mut self.walls,
+                        nl: &mut self.near.list,
+                        sc: &mut self.sc,
+                    };
+                    self.team_steps += 1;
+                    team_step::<FR>(self.kernel, &self.p, step, s, x_ref, &self.ext)
+                }
+                // Two parallel loops, which cannot wait on another team's threads.
+                None => {
+                    let state = (&self.x[..], &self.v[..], &self.w[..]);
+                    let st1 = pair_pass::<FR>(&self.p, state, &mut self.near.list, &mut self.sc, self.kernel);
+                    let m = Motion {
+                        x: &mut self.x,
+                        v: &mut self.v,
+                        w: &mut self.w,
+                        past: &mut self.past,
+                        x_ref,
+                        walls: &mut self.walls,
+                    };
+                    st1.max(update_pass::<FR>(self.kernel, &self.p, step, m, &self.ext, self.sc.sums()))
+                }
+            };
+            self.ring = 1 - self.ring;
+            self.levels = (self.levels + 1).min(3);
+            st
+        };
+        self.last = (st.overlap, st.coulomb_excess);
+        self.last_move = st.moved;
+        let (disp2, measured) = if exact {
+            (st.disp2, true)
+        } else {
+            // |Δx| ≤ √3 (max |Δx_k| + rounding of the new coordinate, ≤ ε/2 of it).
+            let grown = self.moved_bound + SQRT_3 * (st.moved + 0.5 * f64::EPSILON * st.extent) * (1.0 + 1e-12);
+            if grown < safe {
+                self.moved_bound = grown;
+                (0.0, false) // below the limit (and so below the exact check's result) for certain
+            } else {
+                (self.largest_disp2(), true)
+            }
+        };
+        if measured {
+            // The computed distance is within a few ε of the true one.
+            self.moved_bound = disp2.sqrt() * (1.0 + 1e-12);
+        }
+        if disp2 > refresh_disp2 || self.rebuild_due {
+            let t0 = std::time::Instant::now();
+            if disp2 > refresh_disp2 {
+                self.refresh();
+            }
+            if self.rebuild_due {
+                self.rebuild();
+            }
+            self.neighbour_s += t0.elapsed().as_secs_f64();
+        }
+    }
+
+    /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
+    /// contact histories keep the values of the first evaluation (they are integrated by Euler).
+    pub(super) fn heun<const FR: bool>(&mut self) -> Stats {
+        let n = self.x.len();
+        let h = self.p.dt;
+        let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
+        let st =
+            accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
+        let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
+        let nl = &self.near.list;
+        let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
+        let step = |y: &V3, f: &[f64], c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
+        for i in 0..n {
+            self.x[i] = step(&x0[i], &v0[i], h);
+            self.v[i] = step(&v0[i], &d0[i][..3], h);
+            self.w[i] = step(&w0[i], &d0[i][3..], h);
+        }
+        pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
+        let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
+        accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
+        (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
+        let newer = 1 - self.ring as usize;
+        for i in 0..n {
+            let vs = self.v[i];
+            self.x[i] = step(&step(&x0[i], &v0[i], 0.5 * h), &vs, 0.5 * h);
+            self.v[i] = step(&step(&v0[i], &d0[i][..3], 0.5 * h), &d1[i][..3], 0.5 * h);
+            if FR {
+                self.w[i] = step(&step(&w0[i], &d0[i][3..], 0.5 * h), &d1[i][3..], 0.5 * h);
+            }
+            let q = &mut self.past;
+            q.v[newer][i] = v0[i];
+            q.a[newer][i] = [d0[i][0], d0[i][1], d0[i][2]];
+            q.alpha[newer][i] = [d0[i][3], d0[i][4], d0[i][5]];
+        }
+        self.ring = newer as u8;
+        self.levels = 2;
+        Stats { disp2: self.largest_disp2(), ..st }
+    }
+}
+
+/// √3, rounded up (the bound's factor from the largest component to the length).
+const SQRT_3: f64 = 1.7320508075688774;
