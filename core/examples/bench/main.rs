@@ -4,6 +4,7 @@
 mod cfd;
 mod coupled;
 mod dem;
+mod restitution;
 mod tradeoff;
 mod voidage;
 
@@ -15,6 +16,7 @@ fn main() {
         "coupled-parts" => coupled::parts(),
         "coupled-micro" => coupled::micro(),
         "tradeoff" => tradeoff::run(),
+        "restitution" => restitution::run(),
         "dem" => dem::run(),
         "voidage" => voidage::run(),
         other => {
