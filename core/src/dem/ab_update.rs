@@ -21,6 +21,7 @@ pub(crate) fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], old
 /// As `ab_flat`, returning (max |increment|, max |new y|) (a NaN is passed over); with AVX-512
 /// intrinsics when `isa` proves them. Panics unless the four arrays have one length.
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut, unused_variables))] // the vector path is x86-64 only
 pub(crate) fn ab_flat_moved<const V: bool>(
     isa: Isa<V>,
     hb: [f64; 3],

@@ -197,6 +197,7 @@ unsafe fn chunk_pairs_avx2<const FR: bool>(
 /// lanes hold indices into it (particle − a). Every index is checked (the list may come from a
 /// checkpoint): a bad one panics.
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut, unused_variables))] // the vector path is x86-64 only
 fn chunk_pairs<const FR: bool, const V: bool>(
     isa: Isa<V>,
     c: &ChunkArgs,

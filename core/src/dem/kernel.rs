@@ -113,6 +113,7 @@ pub(crate) struct Isa<const AVX512: bool>(());
 impl<const AVX512: bool> Isa<AVX512> {
     /// The proof of the AVX-512 features, if this is one (a constant for the compiler).
     #[inline(always)]
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) fn as_avx512(self) -> Option<Isa<true>> {
         AVX512.then_some(Isa(()))
     }

@@ -37,6 +37,7 @@ mod near_list;
 mod neighbors;
 mod pair_batch;
 mod pair_scatter;
+#[cfg(target_arch = "x86_64")]
 mod pair_simd;
 mod particle_pass;
 mod real;

@@ -23,6 +23,7 @@ use super::pair_simd::{gather8, write_back8, LANES};
 /// (μF_n)²), the second −∞ unless `inp.audit`. Panics unless every lane's particles index
 /// `inp.v` (and `inp.w` when FR) and its slot lies in base..base + shear.len().
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut, unused_variables))] // the vector path is x86-64 only
 pub(crate) fn evaluate<const FR: bool, const V: bool>(
     isa: Isa<V>,
     b: &mut Batch,

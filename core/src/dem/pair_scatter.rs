@@ -20,6 +20,7 @@ pub(crate) struct PairSum(pub [f32; 8]);
 /// Add lanes 0..batch.m into `acc` (indices as the lanes'), lane by lane, i before j.
 /// Panics unless every lane's particles index `acc`.
 #[inline(always)]
+#[cfg_attr(not(target_arch = "x86_64"), allow(unused_mut, unused_variables))] // the vector path is x86-64 only
 pub(crate) fn scatter<const FR: bool, const V: bool>(isa: Isa<V>, b: &Batch, acc: &mut [PairSum]) {
     let m = b.m.min(CAP);
     #[cfg(target_arch = "x86_64")]
