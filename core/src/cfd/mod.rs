@@ -59,6 +59,7 @@
 mod ab3;
 mod boundary;
 mod geometry;
+mod params;
 mod rhs;
 mod smart;
 mod solver;
@@ -70,7 +71,8 @@ mod tests;
 pub use ab3::{ab2_weights, ab3_weights, AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
 pub use boundary::{outlet_density_change, ramped_superficial_velocity};
 pub use geometry::{horizontal_inverse_spacing, FaceGeometry, HFace, Neighbour};
+pub use params::{GasParams, Outlet};
 pub use rhs::FACE_FLUX_RATE;
 pub use smart::smart_face;
-pub use solver::{GasParams, GasSolver, Outlet};
+pub use solver::GasSolver;
 pub use stability::{case_stable_time_step, cell_stable_dt};

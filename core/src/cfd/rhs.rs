@@ -24,8 +24,8 @@
 
 use super::boundary::ramped_superficial_velocity;
 use super::geometry::FaceGeometry;
+use super::params::{GasParams, Outlet};
 use super::smart::smart_face;
-use super::solver::{GasParams, Outlet};
 
 /// Primitive fields computed from the state before each right-hand side.
 #[derive(Clone, Debug, Default)]

@@ -4,6 +4,7 @@
 use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::outlet_density_change;
 use super::geometry::FaceGeometry;
+use super::params::{GasParams, Outlet};
 use super::rhs::{
     axial_layer, gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives,
     RhsInput,
@@ -13,31 +14,6 @@ use crate::case::Case;
 use crate::grid::CylGrid;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
-
-/// Top boundary of the gas.
-#[derive(Clone, Copy, Debug, Serialize, Deserialize, PartialEq, Eq)]
-pub enum Outlet {
-    /// Characteristic outlet of the paper's eq. (5)–(7) (PHYSICS.md 9), optional relaxation σ.
-    Characteristic,
-    /// A shut top: full-slip wall (tests: closed column, fully reflecting end).
-    Wall,
-}
-
-/// Gas parameters in SI units, taken from the case's `gas` section.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct GasParams {
-    pub sound_speed: f64,
-    pub viscosity: f64,
-    pub bulk_viscosity: f64,
-    pub gravity: f64,
-    pub superficial_velocity: f64,
-    pub ramp_time: f64,
-    pub inlet_voidage: f64,
-    pub outlet_relaxation: f64,
-    pub outlet_pressure: f64,
-    pub cfl_factor: f64,
-    pub outlet: Outlet,
-}
 
 /// What the grid is rebuilt from after a checkpoint.
 #[derive(Clone, Debug, Serialize, Deserialize)]
