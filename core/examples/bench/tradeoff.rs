@@ -16,11 +16,11 @@
 //! paper's square grid configuration 3 at every step).
 
 use crate::coupled::{coupled_round, shipped_case, state_at, Tally};
+use crate::voidage::packing;
 use fluidbed_core::case::{BoxSplit, Case, Voidage};
 use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
 use fluidbed_core::grid::CylGrid;
 use fluidbed_core::sim::{fluid_grid, Simulation, Snapshot};
-use rand::{Rng, SeedableRng};
 use serde_json::json;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -159,19 +159,6 @@ fn coupled_front() -> f64 {
         "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)})
     );
     default_cost
-}
-
-/// Random packing of mean voidage `eps` (centres uniform, overlaps allowed: the methods are linear).
-fn packing(g: &CylGrid, eps: f64, a: f64, seed: u64) -> Vec<[f64; 3]> {
-    let n = ((1.0 - eps) * PI * g.radius * g.radius * g.height / (4.0 / 3.0 * PI * a * a * a)).round() as usize;
-    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
-    (0..n)
-        .map(|_| {
-            let r = (g.radius - a) * rng.gen::<f64>().sqrt();
-            let t = rng.gen_range(0.0..2.0 * PI);
-            [r * t.cos(), r * t.sin(), rng.gen_range(a..g.height - a)]
-        })
-        .collect()
 }
 
 /// Mean L1 over three packings and ns per particle per call of `make`'s method.

@@ -33,7 +33,7 @@ fn methods(g: &CylGrid) -> Vec<(String, Box<dyn VoidageMethod>)> {
     m
 }
 
-fn packing(g: &CylGrid, eps: f64, a: f64, seed: u64) -> Vec<[f64; 3]> {
+pub fn packing(g: &CylGrid, eps: f64, a: f64, seed: u64) -> Vec<[f64; 3]> {
     let vp = 4.0 / 3.0 * PI * a * a * a;
     let n = ((1.0 - eps) * PI * g.radius * g.radius * g.height / vp).round() as usize;
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
