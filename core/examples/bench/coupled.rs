@@ -28,14 +28,16 @@ pub fn shipped_case(name: &str) -> Case {
     Case::parse_str(&text).unwrap_or_else(|r| panic!("{path}: {:?}", r.errors)).0
 }
 
-/// The checkpoint of `case` run to `t_end` from its poured bed, cached by the case's text; a
-/// cache the current build cannot read is made again.
+/// The checkpoint of `case` run to `t_end` from its poured bed, cached by the case's text and the
+/// gas step the build plans for it; a cache the current build cannot read is made again.
 pub fn state_at(case: &Case, t_end: f64, label: &str) -> Vec<u8> {
     let key = {
         use std::hash::{Hash, Hasher};
         let mut h = std::collections::hash_map::DefaultHasher::new();
         serde_json::to_string(case).expect("case").hash(&mut h);
         t_end.to_bits().hash(&mut h);
+        // the gas step this build plans (stored in the state, so a new estimate needs a new state)
+        fluidbed_core::cfd::case_stable_time_step(case).map(f64::to_bits).hash(&mut h);
         h.finish()
     };
     let file = cache_dir().join(format!("{label}-{key:016x}.ckpt"));
@@ -204,6 +206,8 @@ pub fn parts() {
     let mut gas2 = gas.clone();
     let dt = sim.plan().gas_dt_s.expect("gas dt");
     time("gas_step", &mut || gas2.step(dt));
+    gas2.set_parallel(false);
+    time("gas_step_one_thread", &mut || gas2.step(dt));
 }
 
 /// Micro-timings of the particle pass's pieces (diagnostic).
@@ -246,4 +250,29 @@ pub fn micro() {
         s += fast_exp(fast_ln(1.0 + (k % 1000) as f64 * 0.07));
     }
     println!("fast exp(ln): {:.1} ns ({s})", t0.elapsed().as_secs_f64() * 1e9 / (reps * n) as f64);
+}
+
+/// The gas alone from the fluidized state (force and voidage held), 80 ms at multiples of its
+/// estimated stable step (stability.rs, cfl_factor 1): the step where it stops staying bounded.
+pub fn gas_dt() {
+    let case = shipped_case("bubbling-44mm.json");
+    let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
+    let base = sim.gas().expect("gas");
+    let limit = base.stable_dt() / base.params().cfl_factor;
+    let span = 0.08;
+    for k in [0.9, 1.0, 1.03, 1.06, 1.1, 1.2] {
+        let mut gas = base.clone();
+        let dt = k * limit;
+        let steps = (span / dt) as usize;
+        let blew_up_at = (0..steps).find(|&s| {
+            gas.step(dt);
+            s % 100 == 0 && gas.check_finite().is_err()
+        });
+        let bounded = blew_up_at.is_none() && gas.check_finite().is_ok();
+        println!(
+            "{}",
+            json!({"bench": "gas_dt", "step_over_limit": k, "dt_s": dt, "steps": steps, "bounded": bounded,
+                   "blew_up_at_step": blew_up_at, "mass_ratio": if bounded { gas.total_mass() / base.total_mass() } else { f64::NAN }})
+        );
+    }
 }

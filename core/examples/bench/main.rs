@@ -15,6 +15,7 @@ fn main() {
         "coupled" => coupled::run(),
         "coupled-parts" => coupled::parts(),
         "coupled-micro" => coupled::micro(),
+        "gas-dt" => coupled::gas_dt(),
         "tradeoff" => tradeoff::run(),
         "restitution" => restitution::run(),
         "dem" => dem::run(),

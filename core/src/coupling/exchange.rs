@@ -41,7 +41,8 @@ pub fn cart_to_cyl(v: [f64; 3], cos: f64, sin: f64) -> [f64; 3] {
 fn angle_of(x: f64, y: f64) -> (f64, f64) {
     let r = (x * x + y * y).sqrt();
     if r > 0.0 {
-        (x / r, y / r)
+        let inv = 1.0 / r;
+        (x * inv, y * inv)
     } else {
         (1.0, 0.0)
     }

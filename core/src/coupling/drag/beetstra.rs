@@ -47,7 +47,7 @@ impl DragLaw for Beetstra {
             f0: 10.0 * phi / (eps * eps) + eps * eps * (1.0 + 1.5 * phi.max(0.0).sqrt()),
             b: 0.413 / (24.0 * eps * eps),
             c: 1.0 / eps + 3.0 * eps * phi,
-            p10: 10f64.powf(3.0 * phi),
+            p10: fast_exp(3.0 * std::f64::consts::LN_10 * phi),
             e1: -(1.0 + 4.0 * phi) / 2.0,
         }
     }

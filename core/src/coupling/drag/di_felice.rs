@@ -28,7 +28,7 @@ impl DragLaw for DiFelice {
         a * a * eps.powf(-chi(re)) / 24.0
     }
     fn cell(&self, eps: f64) -> DiFeliceCell {
-        DiFeliceCell { ln_eps: eps.ln() }
+        DiFeliceCell { ln_eps: fast_ln(eps) }
     }
     #[inline(always)]
     fn f_cell(c: &DiFeliceCell, re: f64) -> f64 {

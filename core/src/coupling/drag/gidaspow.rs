@@ -38,7 +38,7 @@ impl DragLaw for Gidaspow {
     fn cell(&self, eps: f64) -> GidaspowCell {
         let phi = 1.0 - eps;
         let e2 = 18.0 * eps * eps;
-        GidaspowCell { ergun: eps <= EPS_SWITCH, a: 150.0 * phi / e2, b: 1.75 / e2, s: eps.powf(-3.65) }
+        GidaspowCell { ergun: eps <= EPS_SWITCH, a: 150.0 * phi / e2, b: 1.75 / e2, s: fast_exp(-3.65 * fast_ln(eps)) }
     }
     #[inline(always)]
     fn f_cell(c: &GidaspowCell, re: f64) -> f64 {
