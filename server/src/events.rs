@@ -57,7 +57,7 @@ impl Hub {
     }
 }
 
-/// The `snapshot` event's payload: cell voidage and pressure, total and per-layer ΔP.
+/// The `snapshot` event's payload: the grid, cell voidage and pressure, total and per-layer ΔP.
 pub fn snapshot_payload(s: &Snapshot, info: &SnapshotInfo) -> Value {
     json!({
         "n": s.index,
@@ -65,6 +65,7 @@ pub fn snapshot_payload(s: &Snapshot, info: &SnapshotInfo) -> Value {
         "step": s.step,
         "cells_per_layer": s.grid.grid().cells_per_layer(),
         "nz": s.grid.nz,
+        "grid": s.grid,
         "voidage": fields::voidage(s),
         "pressure_pa": s.pressure_pa,
         "pressure_drop_pa": s.pressure_drop_pa,

@@ -13,6 +13,7 @@ pub mod events;
 pub mod health;
 pub mod job;
 pub mod listener;
+pub mod page;
 pub mod store;
 pub mod worker;
 

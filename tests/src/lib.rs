@@ -8,6 +8,8 @@ use std::time::{Duration, Instant};
 
 pub use fluidbed::watch::{parse_events, SseEvent};
 
+pub mod webdriver;
+
 /// A temporary folder removed on drop.
 pub struct TempDir(pub PathBuf);
 

@@ -62,8 +62,8 @@ pub struct DemSystem {
     /// Wall time of near-list refreshes and Verlet-list rebuilds (timers).
     #[serde(skip)]
     pub(super) neighbour_s: f64,
-    /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size).
-    #[serde(skip)]
+    /// Chunk plan and force buffers of the pair pass (rebuilt with the list or the pool size);
+    /// a checkpoint holds the plan's cuts only.
     pub(super) sc: Scratch,
     /// The code path of the passes (`FLUIDBED_KERNEL`, else the best the CPU has).
     #[serde(skip, default = "Kernel::from_env")]

@@ -1,9 +1,11 @@
 //! The work split of the pair pass (`Scratch`): contiguous particle chunks of about equal work,
-//! each with a private force buffer, planned once per neighbour-list build.
+//! each with a private force buffer, planned once per neighbour-list build. A checkpoint carries
+//! the plan's cuts, so that a restored run sums its pair forces in the same order.
 
 use super::neighbors::NeighborList;
 use super::pair_scatter::PairSum;
 use rayon::prelude::*;
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// Extra work units of a touching pair over a listed one in the chunk cuts. Timed per thread
 /// on the settled bench bed (docs/BENCHMARKS.md, "Sharing the work"): weights 0 / 2 / 4 left
@@ -12,8 +14,10 @@ const TOUCH_WEIGHT: usize = 2;
 
 /// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
 /// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
-/// partner index of the chunk. The chunks depend only on the list and the chunk count, and the
-/// buffers are summed in chunk order, so a run is bit-reproducible for a given chunk count.
+/// partner index of the chunk. The cuts depend on the list, its touch flags when planned and the
+/// chunk count, and the buffers are summed in chunk order, so a run is bit-reproducible for a
+/// given chunk count as long as a plan lives until the list changes — through a checkpoint too
+/// (the flags have changed since the plan was made, so a new plan could cut elsewhere).
 #[derive(Clone, Debug, Default)]
 pub struct Scratch {
     /// Per chunk: a, b, e.
@@ -23,6 +27,30 @@ pub struct Scratch {
     pub acc: Vec<PairSum>,
     /// Row (first particle) of every list entry.
     pub owner: Vec<u32>,
+    /// The chunk count the plan was made for.
+    chunks: usize,
+    /// A restored plan (its chunk count and cuts), taken by the next `replan` for that count.
+    carried: Option<CarriedPlan>,
+}
+
+/// What a checkpoint holds of a plan: the chunk count asked for and the nc + 1 cuts.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct CarriedPlan {
+    chunks: usize,
+    cuts: Vec<usize>,
+}
+
+impl Serialize for Scratch {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        let live = (!self.bounds.is_empty()).then(|| CarriedPlan { chunks: self.chunks, cuts: self.cuts() });
+        live.or_else(|| self.carried.clone()).serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for Scratch {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Scratch, D::Error> {
+        Ok(Scratch { carried: Option::deserialize(d)?, ..Scratch::default() })
+    }
 }
 
 /// The chunk buffers as the particle pass reads them: a read-only view that hands out only the
@@ -83,7 +111,14 @@ impl Scratch {
         sc
     }
 
-    /// `plan` in this scratch's storage (reused: no fresh pages for the buffers).
+    /// The chunk boundaries: a of each chunk, then b of the last.
+    fn cuts(&self) -> Vec<usize> {
+        let last = self.bounds.last().map(|b| b[1]);
+        self.bounds.iter().map(|b| b[0]).chain(last).collect()
+    }
+
+    /// `plan` in this scratch's storage (reused: no fresh pages for the buffers); a plan carried
+    /// through a checkpoint for this chunk count and list length is kept.
     pub fn replan(&mut self, nl: &NeighborList, n: usize, chunks: usize) {
         // The pair pass indexes without bounds checks: check the list once here (it may come
         // from a checkpoint) — rows ascending within 0..n, histories and flags one per entry.
@@ -94,6 +129,17 @@ impl Scratch {
         );
         assert!(nl.offsets.windows(2).all(|o| o[0] <= o[1]), "neighbour list offsets");
         assert!(nl.shear.len() == total && nl.touch.len() == total, "contact history length");
+        let carried = self.carried.take().filter(|p| p.chunks == chunks && p.cuts.last() == Some(&n));
+        let cuts = match carried {
+            Some(p) => p.cuts,
+            None => Self::balanced_cuts(nl, n, chunks),
+        };
+        self.plan_at(nl, n, &cuts);
+        self.chunks = chunks;
+    }
+
+    /// Cuts of about equal work.
+    fn balanced_cuts(nl: &NeighborList, n: usize, chunks: usize) -> Vec<usize> {
         let nc = chunks.clamp(1, n.div_ceil(512).max(1));
         // Chunk c ends where the work reaches (c+1)/nc of the total, so that the chunks take
         // about the same time: one unit per particle and per list entry, TOUCH_WEIGHT more per
@@ -117,6 +163,14 @@ impl Scratch {
             }
             lo
         };
+        (0..=nc).map(cut).collect()
+    }
+
+    /// The plan of chunks [cuts[c], cuts[c + 1]).
+    fn plan_at(&mut self, nl: &NeighborList, n: usize, cuts: &[usize]) {
+        let (total, nc) = (nl.nbr.len(), cuts.len() - 1);
+        assert!(cuts[0] == 0 && cuts[nc] == n && cuts.windows(2).all(|c| c[0] <= c[1]), "chunk cuts {cuts:?}");
+        let cut = |c: usize| cuts[c];
         let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
         owner.resize(total, 0);
         // Per chunk, in parallel: check every partner (i < j < n), find the halo end e, and
@@ -151,6 +205,6 @@ impl Scratch {
         }
         acc.clear();
         acc.resize(start[nc], PairSum::default());
-        *self = Scratch { bounds, start, acc, owner };
+        (self.bounds, self.start, self.acc, self.owner) = (bounds, start, acc, owner);
     }
 }

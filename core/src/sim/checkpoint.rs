@@ -6,7 +6,8 @@
 //! finds sections by name, so a format that adds a section still reads the others, and every
 //! refusal names the format (and writer) of the file and of this build, and the section at fault.
 //!
-//! Formats: 1–3 had no header (one bincode blob after the number); 4 is this layout.
+//! Formats: 1–3 had no header (one bincode blob after the number); 4 is this layout; 5 adds the
+//! DEM pair pass's chunk cuts to the `dem` section.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -14,7 +15,7 @@ use std::collections::BTreeMap;
 
 pub(super) const MAGIC: &[u8; 8] = b"FLUIDBED";
 /// Bumped whenever a section changes shape; `describe` shows what a file holds.
-pub(super) const FORMAT: u32 = 4;
+pub(super) const FORMAT: u32 = 5;
 /// Who wrote a checkpoint (in its header, for the messages).
 const WRITER: &str = concat!("fluidbed-core ", env!("CARGO_PKG_VERSION"));
 

@@ -214,7 +214,11 @@ impl Simulation {
         let st = checkpoint::decode(bytes).map_err(SimError::Checkpoint)?;
         let grid = fluid_grid(&st.case);
         let mut sim = Simulation::assemble(st, grid);
-        sim.refresh_voidage_field();
+        // A coupled run holds the voidage of its last coupling, which the gas holds too.
+        match (&sim.st.gas, sim.st.plan.coupling) {
+            (Some(gas), true) => sim.buf.voidage.copy_from_slice(gas.voidage()),
+            _ => sim.refresh_voidage_field(),
+        }
         Ok(sim)
     }
 
@@ -290,5 +294,7 @@ pub fn fluid_grid(case: &Case) -> CylGrid {
     CylGrid::new(case.column.diameter_m / 2.0, case.column.height_m, case.grid.dr_m, case.grid_dz_m(), case.grid.n0)
 }
 
+#[cfg(test)]
+mod resume_tests;
 #[cfg(test)]
 mod tests;

@@ -29,6 +29,7 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/v1/schema/case", get(schema))
         .route("/openapi.json", get(openapi))
         .route("/healthz", get(healthz))
+        .merge(crate::page::routes())
         .fallback(not_found)
         .layer(axum::middleware::from_fn_with_state(app.clone(), auth))
         .layer(DefaultBodyLimit::max(limit))
@@ -66,10 +67,12 @@ async fn not_found() -> Response {
     problem(StatusCode::NOT_FOUND, "Not found", "no such resource")
 }
 
-/// With a token configured, every route but /healthz needs `Authorization: Bearer <token>`.
+/// With a token configured, every route but /healthz and the page's static files needs
+/// `Authorization: Bearer <token>`.
 async fn auth(State(app): State<Arc<App>>, req: Request, next: Next) -> Response {
     if let Some(token) = &app.config.token {
-        if req.uri().path() != "/healthz" {
+        let path = req.uri().path();
+        if path != "/healthz" && !crate::page::is_page_path(path) {
             let given = req
                 .headers()
                 .get(header::AUTHORIZATION)
