@@ -1,6 +1,7 @@
 //! Validation runs: `cargo run --release -p fluidbed-core --example validate -- <name>`.
 //! Each prints its figures and, last, one JSON line {"name","figure","reference","rel_err",...}.
 
+mod analysis_signals;
 mod bubbling;
 mod common;
 mod fig3;
@@ -24,10 +25,11 @@ fn main() {
         "fig3" => report(fig3::run()),
         "umf" => report(umf::run()),
         "bubbling" => report(bubbling::run()),
+        "analysis-signals" => report(analysis_signals::run()),
         // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
         "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),
         other => {
-            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, fig3 or bubbling");
+            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, fig3, bubbling or analysis-signals");
             std::process::exit(2);
         }
     }

@@ -1,40 +1,44 @@
-//! Pressure drop, time averages, particle-based averages.
+//! The paper's analyses (sections 3.3–3.4, Figs 6–9) as pure functions and accumulators: slices
+//! in, numbers or structs out, no I/O. Every sampled signal is taken at a uniform step `dt`.
+//!
+//! - [`layers`]: layer means of a cell field and the bed pressure drop from them;
+//! - [`stats`]: mean and standard deviation of a signal (ΔP);
+//! - [`spectrum`]: Welch power spectrum and its dominant frequency;
+//! - [`correlation`]: cross-correlation of two signals and the rise velocity it gives (Müller et
+//!   al. 2007a);
+//! - [`layer_series`]: cross-section voidage (or pressure) per layer over time, the input of the
+//!   bubble counts and correlations;
+//! - [`bubble_count`]: bubbles passing a height per second (threshold crossings with hysteresis);
+//! - [`bubble_fraction`]: bubble volume fraction by height;
+//! - [`particle_average`]: particle-based time averages per cell (Boyce et al. 2013);
+//! - [`field_average`]: time averages of the cell fields (voidage, gas velocity);
+//! - [`profiles`]: radial profiles at chosen heights and azimuthal-mean maps on the axial plane.
+//!
+//! The accumulators (`LayerSeries`, `BubbleFraction`, `ParticleAverage`, `FieldAverage`) are
+//! `Serialize + Deserialize` so a running job can keep them in its checkpoint; each has
+//! `add_sample(..)` and `finish()`, which reads the state without consuming it.
 
-use crate::grid::CylGrid;
+pub mod bubble_count;
+pub mod bubble_fraction;
+pub mod correlation;
+pub mod field_average;
+pub mod layer_series;
+pub mod layers;
+pub mod particle_average;
+pub mod profiles;
+pub mod spectrum;
+pub mod stats;
 
-/// Mean of a cell field over each layer (all cells have one volume, so a plain mean).
-pub fn layer_means(grid: &CylGrid, field: &[f64]) -> Vec<f64> {
-    let per = grid.cells_per_layer();
-    field.chunks(per).map(|l| l.iter().sum::<f64>() / per as f64).collect()
-}
-
-/// Total pressure drop from the distributor (z = 0) to the top of the column, from layer-mean
-/// pressures L_k (centres at (k + ½)dz). The plate pressure is extrapolated as
-/// p(0) = (L0 + L1)/2 + (L0 − L2)/2, exact for a linear profile and blind to an odd–even ripple
-/// (±A on alternate layers cancels in both terms); the top is the mean of the last two layers.
-pub fn bed_pressure_drop(layers: &[f64]) -> f64 {
-    let n = layers.len();
-    let bottom = match n {
-        0 => return 0.0,
-        1 | 2 => layers[0],
-        _ => 0.5 * (layers[0] + layers[1]) + 0.5 * (layers[0] - layers[2]),
-    };
-    let top = if n >= 2 { 0.5 * (layers[n - 1] + layers[n - 2]) } else { layers[0] };
-    bottom - top
-}
+pub use bubble_count::{count_bubbles, BubbleCount};
+pub use bubble_fraction::{BubbleFraction, ByHeight};
+pub use correlation::{cross_correlation, rise_velocity, RiseVelocity};
+pub use field_average::{FieldAverage, FieldMeans};
+pub use layer_series::LayerSeries;
+pub use layers::{bed_pressure_drop, layer_means};
+pub use particle_average::{ParticleAverage, ParticleMeans};
+pub use profiles::{axial_map, radial_profile, AxialMap, RadialProfile};
+pub use spectrum::{dominant_frequency, welch, Spectrum};
+pub use stats::{signal_stats, SignalStats};
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn pressure_drop_is_exact_for_a_linear_profile_and_ignores_an_odd_even_ripple() {
-        // p(z) = 1000 − 50 z/dz: the plate is at 1000, the top layers' mean at z = (n − 1) dz
-        let n = 12;
-        let lin: Vec<f64> = (0..n).map(|k| 1000.0 - 50.0 * (k as f64 + 0.5)).collect();
-        let want = 1000.0 - (1000.0 - 50.0 * (n as f64 - 1.0));
-        assert!((bed_pressure_drop(&lin) - want).abs() < 1e-9);
-        let rippled: Vec<f64> = lin.iter().enumerate().map(|(k, p)| p + if k % 2 == 0 { 7.0 } else { -7.0 }).collect();
-        assert!((bed_pressure_drop(&rippled) - want).abs() < 1e-9);
-    }
-}
+mod test_signals;
