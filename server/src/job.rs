@@ -15,6 +15,9 @@ pub enum Status {
 }
 
 impl Status {
+    pub const ALL: [Status; 5] =
+        [Status::Queued, Status::Running, Status::Succeeded, Status::Failed, Status::Cancelled];
+
     pub fn as_str(self) -> &'static str {
         match self {
             Status::Queued => "queued",

@@ -13,6 +13,7 @@ pub mod events;
 pub mod health;
 pub mod job;
 pub mod listener;
+pub mod metrics;
 pub mod page;
 pub mod store;
 pub mod worker;
@@ -81,6 +82,7 @@ pub struct App {
     pub queue: worker::Queue,
     pub cancels: Mutex<HashMap<String, Arc<AtomicBool>>>,
     pub health: health::Health,
+    pub metrics: metrics::Metrics,
     /// Submission token bucket: (tokens, last refill).
     submit_bucket: Mutex<(f64, Instant)>,
     stopping: AtomicBool,
@@ -136,6 +138,7 @@ impl Server {
             queue: worker::Queue::default(),
             cancels: Mutex::new(HashMap::new()),
             health: health::Health::default(),
+            metrics: metrics::Metrics::default(),
             submit_bucket: Mutex::new((4.0 * config.submissions_per_s, Instant::now())),
             stopping: AtomicBool::new(false),
             graceful: AtomicBool::new(false),
@@ -186,7 +189,7 @@ impl Server {
         self.app.graceful.store(true, Ordering::SeqCst);
         self.stop(Duration::from_secs(30));
         if let Err(e) = self.app.store.close() {
-            eprintln!("fluidbed-server: closing the job database: {e:#}");
+            tracing::error!("closing the job database: {e:#}");
         }
     }
 

@@ -44,6 +44,26 @@ struct Args {
     /// Seconds a request body may pause between chunks.
     #[arg(long, default_value_t = 20)]
     body_timeout_s: u64,
+    /// Log lines on stderr as text or as one JSON object each (levels from RUST_LOG, default info).
+    #[arg(long, value_enum, default_value_t = LogFormat::Text)]
+    log_format: LogFormat,
+}
+
+#[derive(Clone, Copy, clap::ValueEnum)]
+enum LogFormat {
+    Text,
+    Json,
+}
+
+/// Logs through `tracing`: spans per request (method, route) and per job (id) on every line.
+fn init_logs(format: LogFormat) {
+    use tracing_subscriber::EnvFilter;
+    let filter = EnvFilter::try_from_default_env().unwrap_or_else(|_| EnvFilter::new("info"));
+    let logs = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr);
+    match format {
+        LogFormat::Text => logs.init(),
+        LogFormat::Json => logs.json().init(),
+    }
 }
 
 /// A byte count with an optional K, M, G or T suffix (powers of 1024).
@@ -76,6 +96,7 @@ fn default_threads() -> usize {
 
 fn main() -> anyhow::Result<()> {
     let a = Args::parse();
+    init_logs(a.log_format);
     let cfg = Config {
         data_dir: a.data_dir,
         listen: a.listen,
@@ -95,11 +116,11 @@ fn main() -> anyhow::Result<()> {
     let server = match Server::start(cfg) {
         Ok(s) => s,
         Err(e) => {
-            eprintln!("fluidbed-server: cannot start: {e:#}");
+            tracing::error!("cannot start: {e:#}");
             std::process::exit(1);
         }
     };
-    eprintln!("fluidbed-server: listening on {} (data in {})", server.url(), dir.display());
+    tracing::info!("listening on {} (data in {})", server.url(), dir.display());
     let rt = tokio::runtime::Builder::new_current_thread().enable_all().build()?;
     rt.block_on(async {
         #[cfg(unix)]
@@ -111,7 +132,7 @@ fn main() -> anyhow::Result<()> {
         tokio::signal::ctrl_c().await?;
         Ok::<_, std::io::Error>(())
     })?;
-    eprintln!("fluidbed-server: stopping; running jobs resume from their checkpoints at the next start");
+    tracing::info!("stopping; running jobs resume from their checkpoints at the next start");
     server.shutdown();
     Ok(())
 }

@@ -282,14 +282,16 @@ impl Store {
         Ok(n > 0)
     }
 
-    pub fn put_snapshot(&self, id: &str, s: &Snapshot, info: &SnapshotInfo) -> Result<()> {
+    /// Store snapshot `s`; the bytes written.
+    pub fn put_snapshot(&self, id: &str, s: &Snapshot, info: &SnapshotInfo) -> Result<u64> {
         let path = self.snapshot_path(id, s.index);
-        write_atomic(&path, &bincode::serialize(s)?).with_context(|| format!("cannot write {}", path.display()))?;
+        let bytes = bincode::serialize(s)?;
+        write_atomic(&path, &bytes).with_context(|| format!("cannot write {}", path.display()))?;
         self.db().execute(
             "INSERT OR REPLACE INTO snapshots (job_id, n, time_s, step, pressure_drop_pa, mean_particle_height_m) VALUES (?1, ?2, ?3, ?4, ?5, ?6)",
             params![id, info.n as i64, info.time_s, info.step as i64, info.pressure_drop_pa, info.mean_particle_height_m],
         )?;
-        Ok(())
+        Ok(bytes.len() as u64)
     }
 
     pub fn snapshots(&self, id: &str) -> Result<Vec<SnapshotInfo>> {

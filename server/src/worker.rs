@@ -4,12 +4,13 @@
 
 use crate::events::{snapshot_payload, JobEvent};
 use crate::job::{now_rfc3339, SnapshotInfo, Status};
+use crate::metrics::JobRate;
 use crate::App;
 use anyhow::Result;
 use fluidbed_core::case::Case;
 use fluidbed_core::dem::solver_pool;
 use fluidbed_core::output::fields;
-use fluidbed_core::sim::Simulation;
+use fluidbed_core::sim::{Simulation, StageTimers};
 use serde_json::json;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -56,8 +57,10 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                 .spawn(move || {
                     while !app.stopping() {
                         if let Some(id) = app.queue.pop(Duration::from_millis(200)) {
+                            let _job = tracing::info_span!("job", id = %id).entered();
                             // A panic in the solver fails its job, not the worker.
                             let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_job(&app, &id)));
+                            app.metrics.job_stopped(&id);
                             let error = match outcome {
                                 Ok(Ok(())) => None,
                                 Ok(Err(e)) => {
@@ -70,7 +73,7 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                                 Err(p) => Some(format!("the solver panicked: {}", panic_text(&*p))),
                             };
                             if let Some(msg) = error.filter(|_| !app.stopping()) {
-                                eprintln!("fluidbed-server: job {id}: {msg}");
+                                tracing::error!("{msg}");
                                 finish(&app, &id, Status::Failed, Some(&msg));
                             }
                         }
@@ -99,11 +102,12 @@ fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
         Ok(false) => None,
         Err(e) => {
             let msg = format!("cannot record that job {id} {}: {e:#}", status.as_str());
-            eprintln!("fluidbed-server: {msg}");
+            tracing::error!("{msg}");
             app.health.write_failed(&msg);
             Some(json!({ "status": status.as_str(), "message": message }))
         }
     };
+    tracing::info!(status = status.as_str(), reason = message, "job ended");
     if let Some(doc) = doc {
         app.hub.publish(id, JobEvent::new("status", None, &doc));
         app.hub.publish(id, JobEvent::new("end", None, &doc));
@@ -151,7 +155,9 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
     // Its own team lock, so that concurrent jobs each step DEM as a team (`team_step`).
     let pool = solver_pool().num_threads(threads).thread_name(|k| format!("fluidbed-job-{k}")).build()?;
     let base_wall = job.wall_s;
-    let out = pool.install(|| drive(app, id, &cancel, base_wall));
+    tracing::info!(threads, resumed = job.status == Status::Running, "job started");
+    let span = tracing::Span::current();
+    let out = pool.install(|| span.in_scope(|| drive(app, id, &cancel, base_wall)));
     if app.stopping() && app.graceful() {
         app.store.release_attempt(id)?;
     }
@@ -211,7 +217,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
     let started = Instant::now();
     let checkpoint_every = sim.case().outputs.checkpoint_interval_s;
     let mut last_checkpoint_t = sim.time();
-    let (t_start, end) = (sim.time(), sim.end_time());
+    let (t_start, end, steps_start) = (sim.time(), sim.end_time(), sim.steps());
     let mut chunk: u64 = 10;
     let mut last_progress = Instant::now() - PROGRESS_EVERY;
     let wall_before = base_wall + prepared_from.elapsed().as_secs_f64();
@@ -248,17 +254,19 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
                 pressure_drop_pa: s.pressure_drop_pa,
                 mean_particle_height_m: fields::mean_particle_height_m(&s),
             };
-            app.store.put_snapshot(id, &s, &info)?;
+            app.metrics.snapshot_written(app.store.put_snapshot(id, &s, &info)?);
             if sim.time() - last_checkpoint_t >= checkpoint_every || sim.is_finished() {
                 if app.stopping() && !app.graceful() {
                     return Ok(());
                 }
-                app.store.put_checkpoint(id, &sim.checkpoint())?;
+                put_checkpoint(app, id, &sim)?;
                 last_checkpoint_t = sim.time();
             }
             app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
             app.hub.publish(id, JobEvent::new("snapshot", Some(s.index), &snapshot_payload(&s, &info)));
         }
+        let stepped = (sim.steps() - steps_start) as f64;
+        app.metrics.job_running(id, job_rate(stepped / started.elapsed().as_secs_f64().max(1e-9), sim.timers()));
         if last_progress.elapsed() >= PROGRESS_EVERY || sim.is_finished() {
             last_progress = Instant::now();
             app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
@@ -284,9 +292,29 @@ fn say(app: &Arc<App>, id: &str, message: Option<&str>) -> Result<()> {
 /// crash-like one (`Server::kill`) writes nothing more.
 fn stop_here(app: &Arc<App>, id: &str, sim: &Simulation) -> Result<()> {
     if app.graceful() {
-        app.store.put_checkpoint(id, &sim.checkpoint())?;
+        put_checkpoint(app, id, sim)?;
     }
     Ok(())
+}
+
+fn put_checkpoint(app: &App, id: &str, sim: &Simulation) -> Result<()> {
+    let bytes = sim.checkpoint();
+    app.store.put_checkpoint(id, &bytes)?;
+    app.metrics.checkpoint_written(bytes.len() as u64);
+    Ok(())
+}
+
+/// The metrics of a running job: its stepping rate and wall time per stage.
+fn job_rate(steps_per_s: f64, t: &StageTimers) -> JobRate {
+    let stages = vec![
+        ("neighbours", t.neighbours),
+        ("contacts_integration", t.contacts_integration),
+        ("voidage", t.voidage),
+        ("exchange", t.exchange),
+        ("gas", t.gas),
+        ("output", t.output),
+    ];
+    JobRate { steps_per_s, stages }
 }
 
 fn fail(app: &Arc<App>, id: &str, message: &str) -> Result<()> {

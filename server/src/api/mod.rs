@@ -29,6 +29,7 @@ pub fn router(app: Arc<App>) -> Router {
         .route("/v1/schema/case", get(schema))
         .route("/openapi.json", get(openapi))
         .route("/healthz", get(healthz))
+        .route("/metrics", get(crate::metrics::handler))
         .merge(crate::page::routes())
         .fallback(not_found)
         .layer(axum::middleware::from_fn_with_state(app.clone(), auth))
@@ -36,6 +37,7 @@ pub fn router(app: Arc<App>) -> Router {
         .layer(RequestBodyTimeoutLayer::new(app.config.body_read_timeout))
         .layer(TimeoutLayer::with_status_code(StatusCode::REQUEST_TIMEOUT, app.config.request_timeout))
         .layer(axum::middleware::from_fn(problem::errors_as_problems))
+        .layer(axum::middleware::from_fn_with_state(app.clone(), crate::metrics::observe))
         .with_state(app)
 }
 
