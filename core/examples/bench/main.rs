@@ -1,10 +1,11 @@
-//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled>`.
+//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled|scaling>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
 mod cfd;
 mod coupled;
 mod dem;
 mod restitution;
+mod scaling;
 mod tradeoff;
 mod voidage;
 
@@ -17,11 +18,12 @@ fn main() {
         "coupled-micro" => coupled::micro(),
         "gas-dt" => coupled::gas_dt(),
         "tradeoff" => tradeoff::run(),
+        "scaling" => scaling::run(),
         "restitution" => restitution::run(),
         "dem" => dem::run(),
         "voidage" => voidage::run(),
         other => {
-            eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage, coupled");
+            eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage, coupled, scaling");
             std::process::exit(2);
         }
     }
