@@ -1,7 +1,8 @@
 //! Bubbling (issue: coupling): the 44-mm bed at U = 0.6 m/s runs (two simulated seconds, so that
 //! `fluidized` has a long time mean; the issue asks for one) with no watchdog stop; voidage maps
 //! every 50 ms from 0.7 to 1 s show the bubbles (cf. paper Fig. 9). The run's ΔP series and the
-//! particles' momentum budget are kept in target/validate-cache for `fluidized` too.
+//! particles' momentum budget are kept in target/validate-cache for `fluidized` too; a stopped run
+//! resumes from the checkpoint it keeps there every 0.05 s.
 
 use crate::common::*;
 use fluidbed_core::case::Field;
@@ -50,60 +51,88 @@ pub fn run_to(end_s: f64) -> RunSummary {
         eprintln!("using the run kept in {cache} (delete it to run again)");
         return r;
     }
-    eprintln!("running the bubbling case to {end_s} s; it will be kept in {cache}");
     let t0 = std::time::Instant::now();
-    let mut sim = fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build");
-    let mut snaps = Vec::new();
-    let mut budget = Vec::new();
+    // Progress is kept every 0.05 s beside the cache (`.ckpt`: the simulation, `.partial`: what
+    // was gathered so far), so a stopped run resumes from there.
+    let (ckpt, partial) = (format!("{cache}.ckpt"), format!("{cache}.partial"));
+    let resumed = std::fs::read(&ckpt).ok().and_then(|b| fluidbed_core::sim::Simulation::restore(&b).ok()).and_then(
+        |sim| {
+            let p: Progress = serde_json::from_str(&std::fs::read_to_string(&partial).ok()?).ok()?;
+            Some((sim, p))
+        },
+    );
+    let (mut sim, mut p) = match resumed {
+        Some((sim, p)) => {
+            eprintln!("resuming the bubbling case at t = {:.3} s from {ckpt}", sim.time());
+            (sim, p)
+        }
+        None => {
+            eprintln!("running the bubbling case to {end_s} s; it will be kept in {cache}");
+            (fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build"), Progress::default())
+        }
+    };
+    let wall_before = p.wall_s;
     while !sim.is_finished() {
         if let Some(s) = sim.advance(u64::MAX).unwrap_or_else(|e| panic!("bubbling: {e}")) {
             let dem = sim.dem();
             let [plate, tube, _] = dem.wall_loads();
-            budget.push([s.time_s, plate, tube, dem.external_force_total()[2], dem.momentum()[2]]);
+            p.budget.push([s.time_s, plate, tube, dem.external_force_total()[2], dem.momentum()[2]]);
+            if let Some(dp) = s.pressure_drop_pa {
+                p.dp.push((s.time_s, dp));
+            }
+            let eps = s.voidage.as_ref().expect("voidage field");
+            if s.time_s >= 0.4 - 1e-9 {
+                let g = s.grid.grid();
+                let bed = &eps[..(0.03 / g.dz).floor() as usize * g.cells_per_layer()];
+                let f = bed.iter().filter(|&&e| e > 0.8).count() as f64 / bed.len() as f64;
+                p.bubble_fraction_max = p.bubble_fraction_max.max(f);
+            }
+            let ms = (s.time_s * 1000.0).round() as i64;
+            if (700..=1000).contains(&ms) && ms % 50 == 0 {
+                crate::plots::slice(&s, eps, 0.35, 1.0, &format!("docs/img/bubbling_voidage_{ms:04}ms.png"));
+            }
             if s.index % 10 == 0 {
+                p.wall_s = wall_before + t0.elapsed().as_secs_f64();
                 eprintln!(
                     "[bubbling] t = {:.3} s, ΔP = {:.0} Pa, wall {:.0} s",
                     s.time_s,
                     s.pressure_drop_pa.unwrap_or(0.0),
-                    t0.elapsed().as_secs_f64()
+                    p.wall_s
                 );
-                // the ΔP series and budget so far, in case the run is stopped early
-                let dp: Vec<(f64, f64)> = snaps
-                    .iter()
-                    .chain(std::iter::once(&s))
-                    .filter_map(|x: &fluidbed_core::sim::Snapshot| x.pressure_drop_pa.map(|p| (x.time_s, p)))
-                    .collect();
                 std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-                std::fs::write(format!("{cache}.partial"), json!({"dp": dp, "budget": budget}).to_string())
-                    .expect("write partial");
+                write_atomically(&ckpt, &sim.checkpoint());
+                write_atomically(&partial, serde_json::to_string(&p).expect("progress").as_bytes());
             }
-            snaps.push(s);
         }
     }
-    let mut bubble_fraction_max: f64 = 0.0;
-    for s in snaps.iter().filter(|s| s.time_s >= 0.4 - 1e-9) {
-        let eps = s.voidage.as_ref().unwrap();
-        let g = s.grid.grid();
-        let bed = &eps[..(0.03 / g.dz).floor() as usize * g.cells_per_layer()];
-        let f = bed.iter().filter(|&&e| e > 0.8).count() as f64 / bed.len() as f64;
-        bubble_fraction_max = bubble_fraction_max.max(f);
-        let ms = (s.time_s * 1000.0).round() as i64;
-        if (700..=1000).contains(&ms) && ms % 50 == 0 {
-            crate::plots::slice(s, eps, 0.35, 1.0, &format!("docs/img/bubbling_voidage_{ms:04}ms.png"));
-        }
-    }
-    crate::plots::pressure_trace(&snaps, "docs/img/bubbling_dp.png", None);
+    crate::plots::pressure_trace(&p.dp, "docs/img/bubbling_dp.png");
     let r = RunSummary {
         particles: sim.dem().len(),
         end_s: sim.time(),
-        dp: snaps.iter().filter_map(|s| s.pressure_drop_pa.map(|p| (s.time_s, p))).collect(),
-        bubble_fraction_max,
-        wall_s: t0.elapsed().as_secs_f64(),
-        budget,
+        dp: p.dp,
+        bubble_fraction_max: p.bubble_fraction_max,
+        wall_s: wall_before + t0.elapsed().as_secs_f64(),
+        budget: p.budget,
     };
     std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-    std::fs::write(cache, serde_json::to_string(&r).unwrap()).expect("write cache");
+    write_atomically(cache, serde_json::to_string(&r).unwrap().as_bytes());
+    let _ = (std::fs::remove_file(&ckpt), std::fs::remove_file(&partial));
     r
+}
+
+/// What a run has gathered so far (kept beside its checkpoint).
+#[derive(Default, Serialize, Deserialize)]
+struct Progress {
+    dp: Vec<(f64, f64)>,
+    budget: Vec<[f64; 5]>,
+    bubble_fraction_max: f64,
+    wall_s: f64,
+}
+
+fn write_atomically(path: &str, bytes: &[u8]) {
+    let tmp = format!("{path}.tmp");
+    std::fs::write(&tmp, bytes).unwrap_or_else(|e| panic!("{tmp}: {e}"));
+    std::fs::rename(&tmp, path).unwrap_or_else(|e| panic!("{path}: {e}"));
 }
 
 pub fn run() -> serde_json::Value {

@@ -11,10 +11,10 @@ fn save(img: &fluidbed_core::output::png::Image, path: &str) {
     eprintln!("wrote {path}");
 }
 
-/// ΔP against time (with the reference as a second, flat series when given).
-pub fn pressure_trace(snaps: &[Snapshot], path: &str, _reference: Option<f64>) {
-    let t: Vec<f64> = snaps.iter().filter(|s| s.pressure_drop_pa.is_some()).map(|s| s.time_s).collect();
-    let y: Vec<f64> = snaps.iter().filter_map(|s| s.pressure_drop_pa).collect();
+/// ΔP against time.
+pub fn pressure_trace(points: &[(f64, f64)], path: &str) {
+    let t: Vec<f64> = points.iter().map(|x| x.0).collect();
+    let y: Vec<f64> = points.iter().map(|x| x.1).collect();
     save(&plot::trace(&t, &y), path);
 }
 
