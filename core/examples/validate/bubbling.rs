@@ -55,12 +55,11 @@ pub fn run_to(end_s: f64) -> RunSummary {
     // Progress is kept every 0.05 s beside the cache (`.ckpt`: the simulation, `.partial`: what
     // was gathered so far), so a stopped run resumes from there.
     let (ckpt, partial) = (format!("{cache}.ckpt"), format!("{cache}.partial"));
-    let resumed = std::fs::read(&ckpt).ok().and_then(|b| fluidbed_core::sim::Simulation::restore(&b).ok()).and_then(
-        |sim| {
+    let resumed =
+        std::fs::read(&ckpt).ok().and_then(|b| fluidbed_core::sim::Simulation::restore(&b).ok()).and_then(|sim| {
             let p: Progress = serde_json::from_str(&std::fs::read_to_string(&partial).ok()?).ok()?;
             Some((sim, p))
-        },
-    );
+        });
     let (mut sim, mut p) = match resumed {
         Some((sim, p)) => {
             eprintln!("resuming the bubbling case at t = {:.3} s from {ckpt}", sim.time());

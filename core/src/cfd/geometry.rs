@@ -37,14 +37,6 @@ pub struct Neighbour {
     pub sy: f64,
 }
 
-/// A horizontal face as one of its cells sees it: the face's index and σ = +1 when the cell is
-/// the face's `a` (the vector area points out of it), −1 when it is `b`.
-#[derive(Clone, Copy, Debug)]
-pub struct IncidentFace {
-    pub face: u32,
-    pub sign: f64,
-}
-
 /// Geometry shared by all layers.
 #[derive(Clone, Debug)]
 pub struct FaceGeometry {
@@ -58,8 +50,6 @@ pub struct FaceGeometry {
     /// Per in-layer cell: its horizontal neighbours (CSR) with outward vector areas.
     pub nb_start: Vec<usize>,
     pub nb: Vec<Neighbour>,
-    /// The same faces as `nb` (same order: ascending face index), by face index and side.
-    pub incident: Vec<IncidentFace>,
     /// max over cells of Σ_f (|S_f|/δ_f)/V over all faces (horizontal and axial), 1/m²: the
     /// spectral radius of the compact Laplacian is at most 2× this times the diffusivity.
     pub max_laplacian_factor: f64,
@@ -132,13 +122,11 @@ impl FaceGeometry {
                 }
             }
         }
-        let mut lists: Vec<Vec<(Neighbour, IncidentFace)>> = vec![Vec::new(); per];
+        let mut lists: Vec<Vec<Neighbour>> = vec![Vec::new(); per];
         let mut lap = vec![0.0; per];
-        for (n, f) in faces.iter().enumerate() {
-            let n = n as u32;
-            lists[f.a as usize].push((Neighbour { c: f.b, sx: f.sx, sy: f.sy }, IncidentFace { face: n, sign: 1.0 }));
-            lists[f.b as usize]
-                .push((Neighbour { c: f.a, sx: -f.sx, sy: -f.sy }, IncidentFace { face: n, sign: -1.0 }));
+        for f in &faces {
+            lists[f.a as usize].push(Neighbour { c: f.b, sx: f.sx, sy: f.sy });
+            lists[f.b as usize].push(Neighbour { c: f.a, sx: -f.sx, sy: -f.sy });
             lap[f.a as usize] += f.area_over_delta;
             lap[f.b as usize] += f.area_over_delta;
         }
@@ -146,37 +134,18 @@ impl FaceGeometry {
         let volume = g.cell_volume();
         let max_lap = lap.iter().fold(0.0f64, |m, &x| m.max(x)) + 2.0 * area_z / dz;
         let mut nb_start = vec![0];
-        let (mut nb, mut incident) = (Vec::new(), Vec::new());
+        let mut nb = Vec::new();
         for l in lists {
-            for (n, i) in l {
-                nb.push(n);
-                incident.push(i);
-            }
+            nb.extend(l);
             nb_start.push(nb.len());
         }
-        FaceGeometry {
-            faces,
-            cos_c,
-            sin_c,
-            area_z,
-            volume,
-            nb_start,
-            nb,
-            incident,
-            max_laplacian_factor: max_lap / volume,
-        }
+        FaceGeometry { faces, cos_c, sin_c, area_z, volume, nb_start, nb, max_laplacian_factor: max_lap / volume }
     }
 
     /// Horizontal neighbours of in-layer cell c with outward vector areas.
     #[inline]
     pub fn neighbours(&self, c: usize) -> &[Neighbour] {
         &self.nb[self.nb_start[c]..self.nb_start[c + 1]]
-    }
-
-    /// Horizontal faces of in-layer cell c in ascending face order.
-    #[inline]
-    pub fn incident(&self, c: usize) -> &[IncidentFace] {
-        &self.incident[self.nb_start[c]..self.nb_start[c + 1]]
     }
 
     /// Cartesian (x, y) of cylindrical (r, θ) components in the basis of in-layer cell c.

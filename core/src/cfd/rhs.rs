@@ -167,28 +167,26 @@ pub fn gradients_layer(
     gx: &mut [f64],
     gy: &mut [f64],
     gz: &mut [f64],
-    scratch: &mut [[f64; 3]],
 ) {
     let (per, base, geo, par) = (inp.per, k * inp.per, inp.geo, inp.params);
     let a2 = par.sound_speed * par.sound_speed;
-    // Per face (no cell is written twice, so the faces are independent): the flux ½(u_a + u_b)·S
-    // and (p_f − p_c)·S, which is ½(p_b − p_a)·S for both cells.
-    for (f, out) in geo.faces.iter().zip(scratch.iter_mut()) {
-        let (a, b) = (base + f.a as usize, base + f.b as usize);
-        let flux = 0.5 * ((pr.ux[a] + pr.ux[b]) * f.sx + (pr.uy[a] + pr.uy[b]) * f.sy);
-        let dp = 0.5 * (pr.p[b] - pr.p[a]);
-        *out = [flux, dp * f.sx, dp * f.sy];
-    }
-    // Per cell, its faces in face order: the flux leaves a and enters b.
     for c in 0..per {
-        let (mut d, mut x, mut y) = (0.0, 0.0, 0.0);
-        for inc in geo.incident(c) {
-            let v = scratch[inc.face as usize];
-            d += inc.sign * v[0];
-            x += v[1];
-            y += v[2];
-        }
-        (div[c], gx[c], gy[c]) = (d, x, y);
+        div[c] = 0.0;
+        gx[c] = 0.0;
+        gy[c] = 0.0;
+    }
+    for f in &geo.faces {
+        let (la, lb) = (f.a as usize, f.b as usize);
+        let (a, b) = (base + la, base + lb);
+        let flux = 0.5 * ((pr.ux[a] + pr.ux[b]) * f.sx + (pr.uy[a] + pr.uy[b]) * f.sy);
+        div[la] += flux;
+        div[lb] -= flux;
+        // (p_f − p_c)·S_out is ½(p_b − p_a)·S for both cells.
+        let dp = 0.5 * (pr.p[b] - pr.p[a]);
+        gx[la] += dp * f.sx;
+        gy[la] += dp * f.sy;
+        gx[lb] += dp * f.sx;
+        gy[lb] += dp * f.sy;
     }
     let (w_in, _) = inp.inlet();
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
@@ -287,7 +285,7 @@ pub fn axial_layer(
     }
 }
 
-#[allow(clippy::needless_range_loop, clippy::too_many_arguments)] // cells index several arrays at once
+#[allow(clippy::needless_range_loop)] // cells are indexed in several arrays at once
 /// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of the
 /// layer's horizontal face corrections into `out_fh`; `axial` holds the axial faces of
 /// `axial_layer` (the one below layer k at index k − 1, the one above at k).
@@ -299,7 +297,6 @@ pub fn residual_layer(
     k: usize,
     out: &mut [[f64; 4]],
     out_fh: &mut [f64],
-    scratch: &mut [[f64; 7]],
 ) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let base = k * per;
@@ -309,51 +306,47 @@ pub fn residual_layer(
         out_fh.iter_mut().for_each(|r| *r = 0.0);
         return;
     }
-    let inv_v = 1.0 / geo.volume;
-    let lam_coef = par.bulk_viscosity + par.viscosity / 3.0;
-    let kappa_a = PRESSURE_DISSIPATION / par.sound_speed;
-    let a2 = par.sound_speed * par.sound_speed;
-    let ff_h = inp.face_flux_h(k);
-    // Horizontal faces (central in r and θ), each once: the convective flux from a to b per unit
-    // volume [ṁ, ṁu_x, ṁu_y, ṁu_z]/V and the viscous stress (3), into `scratch`; dF/dt into `out_fh`.
-    for (((f, &ff), fh), out) in geo.faces.iter().zip(ff_h).zip(out_fh.iter_mut()).zip(scratch.iter_mut()) {
-        let (a, b) = (base + f.a as usize, base + f.b as usize);
-        let eps_f = 0.5 * (inp.eps[a] + inp.eps[b]);
-        let mismatch = (pr.p[b] - pr.p[a]) - 0.5 * ((pr.gx[a] + pr.gx[b]) * f.dx + (pr.gy[a] + pr.gy[b]) * f.dy);
-        let diss = kappa_a * eps_f * f.s_abs * mismatch;
-        let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) + ff * f.s_abs - diss;
-        let rho_f = 0.5 * (pr.p[a] + pr.p[b]) / a2;
-        *fh = face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[a] + pr.beta[b]), mismatch, f.delta, ff, par.sound_speed);
-        let h = 0.5 * mflux * inv_v;
-        let m = par.viscosity * f.area_over_delta * inv_v;
-        let lam = lam_coef * 0.5 * (pr.div[a] + pr.div[b]) * inv_v;
-        *out = [
-            mflux * inv_v,
-            h * (pr.ux[a] + pr.ux[b]),
-            h * (pr.uy[a] + pr.uy[b]),
-            h * (pr.uz[a] + pr.uz[b]),
-            m * (pr.ux[b] - pr.ux[a]) + lam * f.sx,
-            m * (pr.uy[b] - pr.uy[a]) + lam * f.sy,
-            m * (pr.uz[b] - pr.uz[a]),
-        ];
-    }
-    // Per cell: the sources — interaction force (cylindrical → Cartesian), gravity ρεg, pressure
-    // −ε∇p — then its faces in face order; a cell gains σ·(−ṁ) and σ·(ε_c τ − ṁu) (σ = ±1).
+    // Sources: interaction force (cylindrical → Cartesian), gravity ρεg, pressure −ε∇p.
     for c in 0..per {
         let i = base + c;
         let f = inp.force[i];
         let (fx, fy) = geo.to_cartesian(c, f[0], f[1]);
         let e = inp.eps[i];
-        let mut r = [0.0, fx - e * pr.gx[i], fy - e * pr.gy[i], f[2] - par.gravity * q[i][0] - e * pr.gz[i]];
-        for inc in geo.incident(c) {
-            let v = &scratch[inc.face as usize];
-            let s = inc.sign;
-            r[0] += s * -v[0];
-            for n in 0..3 {
-                r[n + 1] += s * (e * v[n + 4] - v[n + 1]);
-            }
+        out[c] = [0.0, fx - e * pr.gx[i], fy - e * pr.gy[i], f[2] - par.gravity * q[i][0] - e * pr.gz[i]];
+    }
+    let inv_v = 1.0 / geo.volume;
+    let lam_coef = par.bulk_viscosity + par.viscosity / 3.0;
+    let kappa_a = PRESSURE_DISSIPATION / par.sound_speed;
+    let a2 = par.sound_speed * par.sound_speed;
+    let ff_h = inp.face_flux_h(k);
+    // Horizontal faces (central in r and θ).
+    for (n, f) in geo.faces.iter().enumerate() {
+        let (la, lb) = (f.a as usize, f.b as usize);
+        let (a, b) = (base + la, base + lb);
+        let eps_f = 0.5 * (inp.eps[a] + inp.eps[b]);
+        let mismatch = (pr.p[b] - pr.p[a]) - 0.5 * ((pr.gx[a] + pr.gx[b]) * f.dx + (pr.gy[a] + pr.gy[b]) * f.dy);
+        let diss = kappa_a * eps_f * f.s_abs * mismatch;
+        let mflux = 0.5 * ((q[a][1] + q[b][1]) * f.sx + (q[a][2] + q[b][2]) * f.sy) + ff_h[n] * f.s_abs - diss;
+        let rho_f = 0.5 * (pr.p[a] + pr.p[b]) / a2;
+        out_fh[n] =
+            face_flux_rate(eps_f, rho_f, 0.5 * (pr.beta[a] + pr.beta[b]), mismatch, f.delta, ff_h[n], par.sound_speed);
+        let h = 0.5 * mflux * inv_v;
+        let conv = [mflux * inv_v, h * (pr.ux[a] + pr.ux[b]), h * (pr.uy[a] + pr.uy[b]), h * (pr.uz[a] + pr.uz[b])];
+        let m = par.viscosity * f.area_over_delta * inv_v;
+        let lam = lam_coef * 0.5 * (pr.div[a] + pr.div[b]) * inv_v;
+        let v =
+            [m * (pr.ux[b] - pr.ux[a]) + lam * f.sx, m * (pr.uy[b] - pr.uy[a]) + lam * f.sy, m * (pr.uz[b] - pr.uz[a])];
+        let (ea, eb) = (inp.eps[a], inp.eps[b]);
+        let ra = &mut out[la];
+        ra[0] -= conv[0];
+        for n in 0..3 {
+            ra[n + 1] += ea * v[n] - conv[n + 1];
         }
-        out[c] = r;
+        let rb = &mut out[lb];
+        rb[0] += conv[0];
+        for n in 0..3 {
+            rb[n + 1] += conv[n + 1] - eb * v[n];
+        }
     }
     // Axial faces: bottom and top of this layer (each computed identically by both layers).
     let (w_in, u_in) = inp.inlet();

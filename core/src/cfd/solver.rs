@@ -63,10 +63,6 @@ pub struct GasSolver {
     face_stage: Vec<f64>,
     /// Axial-face fluxes of the current right-hand side (rhs.rs `axial_layer`).
     axial: Vec<[f64; 7]>,
-    /// Per layer and horizontal face: the residual's face values and the gradients' face sums
-    /// (rhs.rs `residual_layer`, `gradients_layer`), so that no cell is a scatter target.
-    face_values: Vec<[f64; 7]>,
-    face_sums: Vec<[f64; 3]>,
     parallel: bool,
 }
 
@@ -119,7 +115,6 @@ impl GasSolver {
         let n = grid.num_cells();
         let geo = FaceGeometry::new(&grid);
         let nf = n + grid.nz * geo.faces.len();
-        let layer_faces = grid.nz * geo.faces.len().max(1);
         if st.face_flux.len() != nf || st.hist_face.iter().any(|h| h.len() != nf) {
             st.face_flux = vec![0.0; nf];
             st.hist_face = [vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]];
@@ -132,8 +127,6 @@ impl GasSolver {
             stage: vec![[0.0; 4]; n],
             face_old: vec![0.0; nf],
             axial: vec![[0.0; 7]; n],
-            face_values: vec![[0.0; 7]; layer_faces],
-            face_sums: vec![[0.0; 3]; layer_faces],
             face_stage: vec![0.0; nf],
             parallel: n >= PARALLEL_MIN_CELLS,
             grid,
@@ -499,18 +492,11 @@ impl GasSolver {
             std::mem::take(&mut pr.gz),
         );
         let prr = &*pr;
-        let (face_values, face_sums) = (&mut self.face_values, &mut self.face_sums);
-        (
-            div.par_chunks_mut(per),
-            gx.par_chunks_mut(per),
-            gy.par_chunks_mut(per),
-            gz.par_chunks_mut(per),
-            face_sums.par_chunks_mut(nf),
-        )
+        (div.par_chunks_mut(per), gx.par_chunks_mut(per), gy.par_chunks_mut(per), gz.par_chunks_mut(per))
             .into_par_iter()
             .with_min_len(rows)
             .enumerate()
-            .for_each(|(k, (d, x, y, z, fs))| gradients_layer(&inp, prr, k, d, x, y, z, fs));
+            .for_each(|(k, (d, x, y, z))| gradients_layer(&inp, prr, k, d, x, y, z));
         (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
         let pr = &*pr;
         let (out_fz, out_fh) = out_face.split_at_mut(q.len());
@@ -523,11 +509,11 @@ impl GasSolver {
             .enumerate()
             .for_each(|(k, (a, fz))| axial_layer(&inp, q, pr, k, a, fz));
         let axial = &*axial;
-        (out.par_chunks_mut(per), out_fh.par_chunks_mut(nf), face_values.par_chunks_mut(nf))
+        (out.par_chunks_mut(per), out_fh.par_chunks_mut(nf))
             .into_par_iter()
             .with_min_len(rows)
             .enumerate()
-            .for_each(|(k, (o, fh, fv))| residual_layer(&inp, q, pr, axial, k, o, fh, fv));
+            .for_each(|(k, (o, fh))| residual_layer(&inp, q, pr, axial, k, o, fh));
     }
 }
 
