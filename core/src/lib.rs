@@ -10,3 +10,4 @@ pub mod dem;
 pub mod grid;
 pub mod output;
 pub mod sim;
+mod team;

@@ -210,6 +210,37 @@ pub fn parts() {
     time("gas_step_one_thread", &mut || gas2.step(dt));
 }
 
+/// One gas step on the fluidized state three ways, interleaved in rounds of 20 steps (`bench --
+/// gas-team`): as one team of threads, as four parallel loops, on one thread. Median ms per step.
+pub fn gas_team() {
+    let case = shipped_case("bubbling-44mm.json");
+    let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
+    let dt = sim.plan().gas_dt_s.expect("gas dt");
+    let base = sim.gas().expect("gas").clone();
+    let (mut team, mut loops, mut one) = (base.clone(), base.clone(), base);
+    loops.set_team(false);
+    one.set_parallel(false);
+    let mut times: [Vec<f64>; 3] = Default::default();
+    for _ in 0..60 {
+        for (m, gas) in [&mut team, &mut loops, &mut one].into_iter().enumerate() {
+            let t0 = Instant::now();
+            for _ in 0..20 {
+                gas.step(dt);
+            }
+            times[m].push(t0.elapsed().as_secs_f64() * 1e3 / 20.0);
+        }
+    }
+    let median = |v: &mut Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let [a, b, c] = times.each_mut().map(median);
+    println!(
+        "{}",
+        json!({"bench": "gas_team", "cells": sim.grid().num_cells(), "team_ms": a, "loops_ms": b, "one_thread_ms": c})
+    );
+}
+
 /// Micro-timings of the particle pass's pieces (diagnostic).
 pub fn micro() {
     use fluidbed_core::coupling::drag::{Beetstra, DragLaw};

@@ -1,5 +1,7 @@
 //! Inlet ramp and the characteristic outlet relation (paper section 2.2, eq. 5–7; PHYSICS.md 9).
 
+use super::params::GasParams;
+
 /// Superficial inlet velocity at time t: a linear ramp from 0 to `u_set` over `ramp_time`
 /// (paper: 240 ms); a zero ramp time means the full value from t = 0.
 #[inline]
@@ -29,6 +31,47 @@ pub fn outlet_density_change(
     let mach2 = (uz / a).powi(2);
     let k = sigma * (1.0 - mach2).max(0.0) * a / length;
     (d_rho_uz - dt * k * a * (rho - rho_inf)) / (uz + a)
+}
+
+/// The grid numbers the outlet update needs.
+#[derive(Clone, Copy)]
+pub struct OutletGeometry {
+    pub per: usize,
+    pub dz: f64,
+    pub height: f64,
+}
+
+/// The characteristic outlet layer after an update (paper eq. 5–7, PHYSICS.md 9): its momentum
+/// changes copy the layer below (as ρU, i.e. divided by that layer's ε), and
+/// Δρ = [Δ(ρU_z) − Δt K a(ρ − ρ_∞)]/(U_z + a). `eps`, `q_old` and `q` start at the layer below
+/// the outlet (two layers each); only the outlet layer of `q` is written.
+pub fn outlet_layer(p: &GasParams, g: OutletGeometry, eps: &[f64], q_old: &[[f64; 4]], q: &mut [[f64; 4]], dt: f64) {
+    let per = g.per;
+    let a = p.sound_speed;
+    // Relaxation target: the hydrostatic density at the outlet cell centre.
+    let rho_inf = p.outlet_pressure / (a * a) * (p.gravity * 0.5 * g.dz / (a * a)).exp();
+    for c in 0..per {
+        let (below, top) = (c, per + c);
+        let (eb, et) = (eps[below], eps[top]);
+        let old = q_old[top];
+        let mut new = old;
+        for n in 1..4 {
+            new[n] = old[n] + et * (q[below][n] - q_old[below][n]) / eb;
+        }
+        let d_rho_uz = (new[3] - old[3]) / et;
+        let d_rho = outlet_density_change(
+            d_rho_uz,
+            old[3] / old[0],
+            a,
+            old[0] / et,
+            rho_inf,
+            p.outlet_relaxation,
+            g.height,
+            dt,
+        );
+        new[0] = old[0] + et * d_rho;
+        q[top] = new;
+    }
 }
 
 #[cfg(test)]

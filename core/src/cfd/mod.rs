@@ -64,6 +64,7 @@ mod rhs;
 mod smart;
 mod solver;
 mod stability;
+mod team_step;
 
 #[cfg(test)]
 mod tests;

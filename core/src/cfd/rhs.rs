@@ -60,6 +60,36 @@ impl Primitives {
             beta: z,
         }
     }
+
+    /// All fields as slices (an empty slice for a field moved out meanwhile).
+    pub fn view(&self) -> PrimView<'_> {
+        PrimView {
+            ux: &self.ux,
+            uy: &self.uy,
+            uz: &self.uz,
+            p: &self.p,
+            div: &self.div,
+            gx: &self.gx,
+            gy: &self.gy,
+            gz: &self.gz,
+            beta: &self.beta,
+        }
+    }
+}
+
+/// The fields of `Primitives` as the passes read them: borrowed slices, so that a team of threads
+/// can read some fields while it still writes others (cfd/team_rhs.rs).
+#[derive(Clone, Copy)]
+pub struct PrimView<'a> {
+    pub ux: &'a [f64],
+    pub uy: &'a [f64],
+    pub uz: &'a [f64],
+    pub p: &'a [f64],
+    pub div: &'a [f64],
+    pub gx: &'a [f64],
+    pub gy: &'a [f64],
+    pub gz: &'a [f64],
+    pub beta: &'a [f64],
 }
 
 /// Everything the right-hand side reads besides the state.
@@ -161,7 +191,7 @@ pub fn top_face_pressure(outlet: Outlet, p_top: f64, p_below: f64, gravity: f64,
 #[allow(clippy::too_many_arguments)]
 pub fn gradients_layer(
     inp: &RhsInput,
-    pr: &Primitives,
+    pr: &PrimView,
     k: usize,
     div: &mut [f64],
     gx: &mut [f64],
@@ -230,7 +260,7 @@ pub fn face_flux_rate(eps_f: f64, rho_f: f64, beta_f: f64, mismatch: f64, delta:
 /// Fluxes across the axial face between cell `lo` (layer kl) and the cell above it: the convective
 /// flux upward [ṁ, ṁu_x, ṁu_y, ṁu_z], the viscous force on `lo` and dF/dt of the face.
 #[inline]
-fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: usize) -> ([f64; 4], [f64; 3], f64) {
+fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, kl: usize, lo: usize) -> ([f64; 4], [f64; 3], f64) {
     let (per, geo, par) = (inp.per, inp.geo, inp.params);
     let hi = lo + per;
     let az = geo.area_z;
@@ -269,14 +299,7 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &Primitives, kl: usize, lo: us
 /// The axial faces above the cells of layer k (k + 1 < nz), computed once for both layers they
 /// join: per face [ṁ, ṁu_x, ṁu_y, ṁu_z, viscous force on the lower cell (3)] into `out` and dF/dt
 /// into `out_fz` (one layer long).
-pub fn axial_layer(
-    inp: &RhsInput,
-    q: &[[f64; 4]],
-    pr: &Primitives,
-    k: usize,
-    out: &mut [[f64; 7]],
-    out_fz: &mut [f64],
-) {
+pub fn axial_layer(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut [[f64; 7]], out_fz: &mut [f64]) {
     let base = k * inp.per;
     for c in 0..inp.per {
         let (conv, visc, dff) = axial_face(inp, q, pr, k, base + c);
@@ -292,7 +315,7 @@ pub fn axial_layer(
 pub fn residual_layer(
     inp: &RhsInput,
     q: &[[f64; 4]],
-    pr: &Primitives,
+    pr: &PrimView,
     axial: &[[f64; 7]],
     k: usize,
     out: &mut [[f64; 4]],

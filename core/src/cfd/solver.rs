@@ -2,7 +2,7 @@
 //! coupled simulation calls. Boundary and axis decisions are documented in cfd/mod.rs.
 
 use super::ab3::{ab2_weights, ab3_weights, combine};
-use super::boundary::outlet_density_change;
+use super::boundary::{outlet_layer, OutletGeometry};
 use super::geometry::FaceGeometry;
 use super::params::{GasParams, Outlet};
 use super::rhs::{
@@ -10,8 +10,10 @@ use super::rhs::{
     RhsInput,
 };
 use super::stability::cell_stable_dt;
+use super::team_step::{fits, team_step, StepInput, StepState};
 use crate::case::Case;
 use crate::grid::CylGrid;
+use crate::team::TeamLock;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -64,6 +66,8 @@ pub struct GasSolver {
     /// Axial-face fluxes of the current right-hand side (rhs.rs `axial_layer`).
     axial: Vec<[f64; 7]>,
     parallel: bool,
+    /// Parallel right-hand sides as one team of threads (team_rhs.rs) rather than four loops.
+    team: bool,
 }
 
 /// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
@@ -129,6 +133,7 @@ impl GasSolver {
             axial: vec![[0.0; 7]; n],
             face_stage: vec![0.0; nf],
             parallel: n >= PARALLEL_MIN_CELLS,
+            team: true,
             grid,
         }
     }
@@ -158,6 +163,11 @@ impl GasSolver {
     /// Process layers on rayon's pool (default: on for grids of 20,000 cells or more).
     pub fn set_parallel(&mut self, on: bool) {
         self.parallel = on;
+    }
+    /// Run parallel right-hand sides as one team of threads when the pool is free for one (default
+    /// on); off, as four parallel loops (the same bits; for benchmarks).
+    pub fn set_team(&mut self, on: bool) {
+        self.team = on;
     }
     pub fn time(&self) -> f64 {
         self.st.time
@@ -354,8 +364,14 @@ impl GasSolver {
     }
 
     /// Advance by dt: Heun for the first step, then AB2, then AB3 with variable-step weights.
-    /// The face corrections F are integrated with the cell state by the same scheme.
+    /// The face corrections F are integrated with the cell state by the same scheme. A multistep
+    /// step runs as one team of threads (team_step.rs) when the pool is free for one.
     pub fn step(&mut self, dt: f64) {
+        if self.st.hist_len > 0 && self.parallel && self.team && fits(self.grid.nz, rayon::current_num_threads()) {
+            if let Some(_team) = TeamLock::try_take() {
+                return self.team_step(dt);
+            }
+        }
         let t = self.st.time;
         self.q_old.copy_from_slice(&self.st.q);
         self.face_old.copy_from_slice(&self.st.face_flux);
@@ -416,40 +432,61 @@ impl GasSolver {
         self.st.steps += 1;
     }
 
-    /// The outlet layer (paper eq. 5–7, PHYSICS.md 9): its momentum changes copy the layer below
-    /// (as ρU, i.e. divided by that layer's ε), and Δρ = [Δ(ρU_z) − Δt K a(ρ − ρ_∞)]/(U_z + a).
+    /// `step` for AB2/AB3 as one team (team_step.rs); the caller holds the pool's `TeamLock`.
+    fn team_step(&mut self, dt: f64) {
+        let newest = (self.st.head + 1) % 3;
+        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
+        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        let hl = self.st.hist_len;
+        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
+        let ab2 = ab2_weights(dt, h1).map(|w| w * dt);
+        let ab3 = ab3_weights(dt, h1, h2).map(|w| w * dt);
+        let (h, hf) = (&self.st.hist, &self.st.hist_face);
+        let (weights, past, past_face): (&[f64], &[&[[f64; 4]]], &[&[f64]]) =
+            if hl == 1 { (&ab2, &[&h[i1]], &[&hf[i1]]) } else { (&ab3, &[&h[i1], &h[i2]], &[&hf[i1], &hf[i2]]) };
+        let inp = StepInput {
+            geo: &self.geo,
+            params: &self.st.params,
+            outlet: OutletGeometry { per: self.grid.cells_per_layer(), dz: self.grid.dz, height: self.grid.height },
+            nz: self.grid.nz,
+            eps: &self.st.eps,
+            force: &self.st.force,
+            time: self.st.time,
+            dt,
+            weights,
+            past,
+            past_face,
+        };
+        let s = StepState {
+            q: &mut self.st.q,
+            face: &mut self.st.face_flux,
+            q_old: &mut self.q_old,
+            face_old: &mut self.face_old,
+            rhs: &mut f_new,
+            rhs_face: &mut g_new,
+            prim: &mut self.prim,
+            axial: &mut self.axial,
+        };
+        team_step(&inp, s);
+        self.st.hist[newest] = f_new;
+        self.st.hist_face[newest] = g_new;
+        self.st.head = newest;
+        self.st.hist_h = [dt, h1];
+        self.st.hist_len = (hl + 1).min(3);
+        self.st.time += dt;
+        self.st.steps += 1;
+    }
+
+    /// The characteristic outlet layer after an update (`outlet_layer`).
     fn apply_outlet(&mut self, dt: f64) {
-        let nz = self.grid.nz;
+        let (nz, per) = (self.grid.nz, self.grid.cells_per_layer());
         if self.st.params.outlet != Outlet::Characteristic || nz < 2 {
             return;
         }
-        let per = self.grid.cells_per_layer();
-        let p = &self.st.params;
-        let a = p.sound_speed;
-        // Relaxation target: the hydrostatic density at the outlet cell centre.
-        let rho_inf = p.outlet_pressure / (a * a) * (p.gravity * 0.5 * self.grid.dz / (a * a)).exp();
-        for c in 0..per {
-            let (top, below) = ((nz - 1) * per + c, (nz - 2) * per + c);
-            let (eb, et) = (self.st.eps[below], self.st.eps[top]);
-            let old = self.q_old[top];
-            let mut new = old;
-            for n in 1..4 {
-                new[n] = old[n] + et * (self.st.q[below][n] - self.q_old[below][n]) / eb;
-            }
-            let d_rho_uz = (new[3] - old[3]) / et;
-            let d_rho = outlet_density_change(
-                d_rho_uz,
-                old[3] / old[0],
-                a,
-                old[0] / et,
-                rho_inf,
-                p.outlet_relaxation,
-                self.grid.height,
-                dt,
-            );
-            new[0] = old[0] + et * d_rho;
-            self.st.q[top] = new;
-        }
+        let lo = (nz - 2) * per;
+        let g = OutletGeometry { per, dz: self.grid.dz, height: self.grid.height };
+        outlet_layer(&self.st.params, g, &self.st.eps[lo..], &self.q_old[lo..], &mut self.st.q[lo..], dt);
     }
 
     /// Right-hand sides of the current state (`self.st.q` into `out`, the face corrections into
@@ -496,9 +533,9 @@ impl GasSolver {
             .into_par_iter()
             .with_min_len(rows)
             .enumerate()
-            .for_each(|(k, (d, x, y, z))| gradients_layer(&inp, prr, k, d, x, y, z));
+            .for_each(|(k, (d, x, y, z))| gradients_layer(&inp, &prr.view(), k, d, x, y, z));
         (pr.div, pr.gx, pr.gy, pr.gz) = (div, gx, gy, gz);
-        let pr = &*pr;
+        let pr = &pr.view();
         let (out_fz, out_fh) = out_face.split_at_mut(q.len());
         out_fz[(nz - 1) * per..].fill(0.0);
         let axial = &mut self.axial;

@@ -18,7 +18,7 @@
 //! - `work_split`: the pair pass's chunks and their force buffers;
 //! - `particle_pass`: the particle pass (buffer sums, walls, gravity, AB3);
 //! - `team_step`, `steal_ranges`: both passes of a step as one team of threads sharing the work;
-//! - `team_lock`: one team per pool at a time; `solver_pool` builds a pool with its own;
+//! - one team per pool at a time: `crate::team` (`solver_pool` builds a pool with its own lock);
 //! - `system`: `DemSystem`, the state; `step`: the step loop; `list_upkeep`: the lists' refresh
 //!   and rebuild; `diagnostics`: energies, loads, counters;
 //! - `bed`: pouring and settling a bed from a seed, with an on-disk cache.
@@ -44,7 +44,6 @@ mod real;
 mod steal_ranges;
 mod step;
 mod system;
-mod team_lock;
 mod team_step;
 mod walls;
 mod work_split;
@@ -52,11 +51,11 @@ mod work_split;
 #[cfg(test)]
 mod tests;
 
+pub use crate::team::solver_pool;
 pub use bed::{build_bed, build_bed_until, fnv1a, Stop, STOPPED};
 pub use contact::{linear_damping_ratio, ContactLaw, ContactStyle, V3};
 pub use kernel::{Kernel, KERNEL_ENV};
 pub use system::DemSystem;
-pub use team_lock::solver_pool;
 
 use crate::case::Case;
 use serde::{Deserialize, Serialize};

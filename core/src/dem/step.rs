@@ -9,8 +9,8 @@ use super::forces::{pair_pass, Acc, Stats};
 use super::integrator::weights;
 use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
 use super::system::DemSystem;
-use super::team_lock::TeamLock;
 use super::team_step::{team_step, StepState};
+use crate::team::TeamLock;
 
 impl DemSystem {
     /// One DEM step of the case's time step (uses the current rayon pool).

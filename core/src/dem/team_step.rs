@@ -15,11 +15,12 @@ use super::neighbors::{Hist, NeighborList};
 use super::pair_scatter::PairSum;
 use super::particle_pass::{block_walls, update_block_on, BlockMotion, Weights, BLOCK};
 use super::steal_ranges::StealRanges;
-#[cfg(test)]
-use super::team_lock::has_own_team;
 use super::walls::WallList;
 use super::work_split::Sums;
 use super::DemParams;
+#[cfg(test)]
+use crate::team::has_own_team;
+use crate::team::Raw;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Spins (then yields) until every chunk c with `need(c)` is done; false if a chunk failed
@@ -40,35 +41,6 @@ fn wait_for_chunks(done: &[AtomicBool], failed: &AtomicBool, need: impl Fn(usize
         }
     }
     true
-}
-
-/// A slice the team reads in (possibly overlapping) windows and writes in disjoint pieces.
-#[derive(Clone, Copy)]
-struct Raw<T> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: `Raw` hands out references only under the phase rules of `team_step`.
-unsafe impl<T: Send + Sync> Send for Raw<T> {}
-unsafe impl<T: Send + Sync> Sync for Raw<T> {}
-
-impl<T> Raw<T> {
-    fn new(s: &mut [T]) -> Self {
-        Raw { ptr: s.as_mut_ptr(), len: s.len() }
-    }
-    /// # Safety
-    /// No mutable reference into lo..hi is live while the returned one is.
-    unsafe fn view<'a>(self, lo: usize, hi: usize) -> &'a [T] {
-        assert!(lo <= hi && hi <= self.len, "view {lo}..{hi} of {}", self.len);
-        std::slice::from_raw_parts(self.ptr.add(lo), hi - lo)
-    }
-    /// # Safety
-    /// No other reference into lo..hi is live while the returned one is.
-    unsafe fn part<'a>(self, lo: usize, hi: usize) -> &'a mut [T] {
-        assert!(lo <= hi && hi <= self.len, "piece {lo}..{hi} of {}", self.len);
-        std::slice::from_raw_parts_mut(self.ptr.add(lo), hi - lo)
-    }
 }
 
 /// Tests only: chunk c panics while this holds c + 1, on pools without their own team lock (the

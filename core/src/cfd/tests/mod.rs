@@ -6,4 +6,5 @@ mod hydrostatic;
 mod layer_pressure;
 mod porous_zone;
 mod support;
+mod team;
 mod validation;

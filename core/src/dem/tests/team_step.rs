@@ -5,9 +5,9 @@
 //! one thread's chunk reaches the caller instead of leaving the other thread waiting for it.
 
 use super::checkpoint::{busy_system, same_state};
-use crate::dem::team_lock::{solver_pool, TeamLock};
 use crate::dem::team_step::PANIC_IN_CHUNK;
 use crate::dem::DemSystem;
+use crate::team::{solver_pool, TeamLock};
 use rayon::prelude::*;
 use std::sync::atomic::Ordering;
 

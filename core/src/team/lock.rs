@@ -1,4 +1,4 @@
-//! At most one team (`team_step`) per rayon pool at a time, and the public way to build a pool
+//! At most one team (`dem::team_step`, `cfd::team_rhs`) per rayon pool at a time, and the public way to build a pool
 //! for stepping systems (`solver_pool`).
 
 use std::cell::RefCell;
