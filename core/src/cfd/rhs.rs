@@ -289,7 +289,7 @@ fn axial_face(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, kl: usize, lo: usiz
         Some(u) => smart_face(v[u], v[c], v[d]),
         None => v[c],
     };
-    let conv = [mflux, mflux * face(&pr.ux), mflux * face(&pr.uy), mflux * face(&pr.uz)];
+    let conv = [mflux, mflux * face(pr.ux), mflux * face(pr.uy), mflux * face(pr.uz)];
     let m = par.viscosity * az / inp.dz;
     let lam = (par.bulk_viscosity + par.viscosity / 3.0) * 0.5 * (pr.div[lo] + pr.div[hi]) * az;
     let visc = [m * (pr.ux[hi] - pr.ux[lo]), m * (pr.uy[hi] - pr.uy[lo]), m * (pr.uz[hi] - pr.uz[lo]) + lam];

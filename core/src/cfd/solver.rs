@@ -443,8 +443,10 @@ impl GasSolver {
         let ab2 = ab2_weights(dt, h1).map(|w| w * dt);
         let ab3 = ab3_weights(dt, h1, h2).map(|w| w * dt);
         let (h, hf) = (&self.st.hist, &self.st.hist_face);
-        let (weights, past, past_face): (&[f64], &[&[[f64; 4]]], &[&[f64]]) =
-            if hl == 1 { (&ab2, &[&h[i1]], &[&hf[i1]]) } else { (&ab3, &[&h[i1], &h[i2]], &[&hf[i1], &hf[i2]]) };
+        let two = [&h[i1][..], &h[i2][..]];
+        let two_face = [&hf[i1][..], &hf[i2][..]];
+        let (weights, m): (&[f64], usize) = if hl == 1 { (&ab2, 1) } else { (&ab3, 2) };
+        let (past, past_face) = (&two[..m], &two_face[..m]);
         let inp = StepInput {
             geo: &self.geo,
             params: &self.st.params,
