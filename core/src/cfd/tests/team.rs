@@ -14,7 +14,7 @@ fn stirred_bed(outlet: Outlet) -> GasSolver {
     let n = s.grid().num_cells();
     let eps: Vec<f64> = (0..n).map(|c| 0.45 + 0.4 * ((c as f64) * 0.37).sin().abs()).collect();
     s.set_initial_voidage(&eps);
-    for c in 0..n {
+    for (c, &e) in eps.iter().enumerate() {
         let [x, y, z] = s.grid().centre_xyz(c);
         let rho = s.density(c) * (1.0 + 1e-3 * (200.0 * z).cos());
         s.set_cell(
@@ -22,7 +22,7 @@ fn stirred_bed(outlet: Outlet) -> GasSolver {
             rho,
             [0.3 * (x * 300.0).sin(), 2.0 * (x * x + y * y).sqrt() * 50.0, 0.4 + 0.4 * (y * 200.0).cos()],
         );
-        s.interaction_force_mut()[c] = [10.0 * (c as f64).cos(), 5.0 * (c as f64).sin(), 800.0 * (1.0 - eps[c])];
+        s.interaction_force_mut()[c] = [10.0 * (c as f64).cos(), 5.0 * (c as f64).sin(), 800.0 * (1.0 - e)];
     }
     s
 }
