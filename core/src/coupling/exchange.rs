@@ -189,7 +189,16 @@ impl Exchange {
                 sum.resize(cells, [0.0; 3]);
                 sum.fill([0.0; 3]);
                 let lo = n * chunk;
-                particle_block_pass::<L>(grid, table, vp, &pos[lo..lo + f.len()], &vel[lo..lo + f.len()], f, co, sum);
+                particle_block_pass_on::<L>(
+                    grid,
+                    table,
+                    vp,
+                    &pos[lo..lo + f.len()],
+                    &vel[lo..lo + f.len()],
+                    f,
+                    co,
+                    sum,
+                );
             });
         // 3. the gas loses the drag: chunk sums in a fixed order, per unit volume
         let inv_v = 1.0 / grid.cell_volume();
@@ -260,10 +269,77 @@ impl Exchange {
     }
 }
 
+/// `particle_block_pass` compiled for the best vector extension the CPU has (and
+/// `FLUIDBED_KERNEL` allows): the same operations in the same order, so the same bits.
+#[allow(clippy::too_many_arguments)]
+fn particle_block_pass_on<L: DragLaw>(
+    grid: &CylGrid,
+    table: &[CellTable<L::Cell>],
+    vp: f64,
+    pos: &[[f64; 3]],
+    vel: &[[f64; 3]],
+    force: &mut [[f64; 3]],
+    cell_of: &mut [u32],
+    gas_sum: &mut [[f64; 3]],
+) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use crate::dem::Kernel;
+        use std::arch::is_x86_feature_detected as has;
+        let kernel = Kernel::from_env();
+        if kernel == Kernel::Avx512 && has!("avx512f") && has!("avx512vl") && has!("avx512dq") {
+            // SAFETY: the CPU has the features the function is compiled for.
+            return unsafe { particle_block_pass_avx512::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum) };
+        }
+        if kernel != Kernel::Portable && has!("avx2") {
+            // SAFETY: as above.
+            return unsafe { particle_block_pass_avx2::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum) };
+        }
+    }
+    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
+}
+
+/// # Safety
+/// The CPU has avx512f, avx512vl and avx512dq.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn particle_block_pass_avx512<L: DragLaw>(
+    grid: &CylGrid,
+    table: &[CellTable<L::Cell>],
+    vp: f64,
+    pos: &[[f64; 3]],
+    vel: &[[f64; 3]],
+    force: &mut [[f64; 3]],
+    cell_of: &mut [u32],
+    gas_sum: &mut [[f64; 3]],
+) {
+    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
+}
+
+/// # Safety
+/// The CPU has avx2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn particle_block_pass_avx2<L: DragLaw>(
+    grid: &CylGrid,
+    table: &[CellTable<L::Cell>],
+    vp: f64,
+    pos: &[[f64; 3]],
+    vel: &[[f64; 3]],
+    force: &mut [[f64; 3]],
+    cell_of: &mut [u32],
+    gas_sum: &mut [[f64; 3]],
+) {
+    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
+}
+
 /// One chunk of the particle pass, in blocks of `BLOCK` particles: the cell and the gas state
 /// per particle (scalar), the drag law's F over the block (branch-free, vectorisable), then the
 /// forces and the chunk's sums for the gas.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn particle_block_pass<L: DragLaw>(
     grid: &CylGrid,
     table: &[CellTable<L::Cell>],
@@ -426,6 +502,50 @@ mod tests {
         for q in 0..3 {
             assert!((drag[q] + gas_side[q]).abs() < 1e-12 * scale * m as f64, "{q}: {} vs {}", drag[q], gas_side[q]);
         }
+    }
+
+    #[test]
+    fn every_code_path_gives_the_same_bits() {
+        // The portable particle pass against the one `particle_gas_forces` runs on this CPU.
+        let g = grid();
+        let n = g.num_cells();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(12);
+        let table: Vec<CellTable<<Beetstra as DragLaw>::Cell>> = (0..n)
+            .map(|c| CellTable {
+                u_cyl: [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)],
+                grad_cyl: [rng.gen_range(-50.0..50.0), rng.gen_range(-50.0..50.0), -6000.0],
+                k: rng.gen_range(1e-10..1e-9),
+                re_per_w: rng.gen_range(10.0..100.0),
+                basis: (c as f64).sin_cos(),
+                law: Beetstra.cell(rng.gen_range(0.35..1.0)),
+            })
+            .collect();
+        let m = 3001;
+        let pos: Vec<[f64; 3]> = (0..m)
+            .map(|k| {
+                let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                // a few particles on the axis and with zero slip (the branch-free edges)
+                if k % 500 == 0 {
+                    [0.0, 0.0, 0.005]
+                } else {
+                    [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
+                }
+            })
+            .collect();
+        let vel: Vec<[f64; 3]> =
+            (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
+        let run = |best: bool| {
+            let (mut f, mut co, mut sum) = (vec![[0.0; 3]; m], vec![0u32; m], vec![[0.0; 3]; n]);
+            if best {
+                particle_block_pass_on::<Beetstra>(&g, &table, 1e-9, &pos, &vel, &mut f, &mut co, &mut sum);
+            } else {
+                particle_block_pass::<Beetstra>(&g, &table, 1e-9, &pos, &vel, &mut f, &mut co, &mut sum);
+            }
+            let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+            (bits(&f), co, bits(&sum))
+        };
+        let (portable, best) = (run(false), run(true));
+        assert!(portable.1 == best.1 && portable.0 == best.0 && portable.2 == best.2, "the paths differ");
     }
 
     #[test]
