@@ -44,6 +44,15 @@ fn bed(seed: u64) -> Case {
     c
 }
 
+/// The trade-off bed with fluid layers as high as the cells are wide (dz = dr; the column height
+/// is a whole number of dr, so each layer is two of the reference's).
+fn layers_of_dr(c: &Case) -> Case {
+    let mut c = c.clone();
+    c.grid.dz_m = Some(c.grid.dr_m);
+    assert!(((c.column.height_m / c.grid.dr_m).round() * c.grid.dr_m - c.column.height_m).abs() < 1e-12);
+    c
+}
+
 /// What a window of snapshots says about the bed.
 struct Stats {
     dp_mean: f64,
@@ -158,6 +167,17 @@ fn coupled_front() -> f64 {
         json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
         "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)})
     );
+    // Fluid layer height dr instead of dr/2: its layers against the reference's merged in pairs.
+    let coarse = layers_of_dr(&reference);
+    let (snaps, cost) = window(&coarse, "tradeoff-dz-dr", coarse.coupling.interval_steps);
+    let s = stats(&snaps, &fluid_grid(&coarse));
+    let pairs = |v: &[f64]| v.chunks(2).map(|p| p.iter().sum::<f64>() / p.len() as f64).collect::<Vec<_>>();
+    let r2 = Stats { axial: pairs(&r.axial), radial: r.radial.clone(), ..r };
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "layer_height", "setting": "dz = dr at the default interval",
+        "wall_s_per_sim_s": cost, "errors": errors(&s, &r2), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+    );
     default_cost
 }
 
@@ -201,6 +221,9 @@ fn interleaved_costs() {
     }
     let sim = Simulation::restore(&exact_state).expect("state");
     runs.push(("exact_cylindrical at the default interval".into(), sim, Tally::default()));
+    let coarse_state = state_at(&layers_of_dr(&reference), SPIN_UP_S, "tradeoff-dz-dr");
+    let sim = Simulation::restore(&coarse_state).expect("state");
+    runs.push(("dz = dr at the default interval".into(), sim, Tally::default()));
     for _ in 0..6 {
         for (_, sim, t) in runs.iter_mut() {
             coupled_round(sim, 1000, t);
