@@ -86,22 +86,33 @@ pub async fn one(
     Path((id, n)): Path<(String, String)>,
     Query(q): Query<SnapshotQuery>,
 ) -> Response {
-    if let Err(r) = find(&app, &id) {
-        return r;
-    }
+    let job = match find(&app, &id) {
+        Ok(j) => j,
+        Err(r) => return r,
+    };
     // Only a plain number names a snapshot; anything else (`..`, `/`) is simply not found.
     let Some(n) = n.parse::<u64>().ok().filter(|_| n.bytes().all(|b| b.is_ascii_digit())) else {
         return problem(StatusCode::NOT_FOUND, "Not found", "no such snapshot");
     };
     let a = app.clone();
-    let snap = match tokio::task::spawn_blocking(move || a.store.snapshot(&id, n)).await {
+    let job_id = id.clone();
+    let snap = match tokio::task::spawn_blocking(move || a.store.snapshot(&job_id, n)).await {
         Ok(Ok(Some(s))) => s,
         Ok(Ok(None)) => return problem(StatusCode::NOT_FOUND, "Not found", "no such snapshot"),
         Ok(Err(e)) => return internal(e),
         Err(e) => return internal(e.into()),
     };
     let (format, field) = (q.format.unwrap_or(SnapshotFormat::Json), q.field());
-    match tokio::task::spawn_blocking(move || encode(&snap, format, field)).await {
+    // A picture of the pressure shows it as gauge pressure, against the case's outlet pressure.
+    let outlet_pa = match (format, field) {
+        (SnapshotFormat::Png, SnapshotField::Pressure) => match app.store.case_json(&id) {
+            Ok(text) => text.and_then(|t| outlet_pressure_pa(&t)),
+            Err(e) => return internal(e),
+        },
+        _ => None,
+    };
+    let figure = Figure { job_name: job.name, outlet_pa };
+    match tokio::task::spawn_blocking(move || encode(&snap, format, field, &figure)).await {
         Ok(r) => r,
         Err(e) => internal(e.into()),
     }
@@ -125,7 +136,49 @@ fn name(field: SnapshotField) -> &'static str {
     }
 }
 
-fn encode(s: &Snapshot, format: SnapshotFormat, field: SnapshotField) -> Response {
+/// What a snapshot's picture needs beside the snapshot.
+struct Figure {
+    job_name: String,
+    /// The case's `gas.outlet_pressure_pa`, the zero of the gauge pressure.
+    outlet_pa: Option<f64>,
+}
+
+fn outlet_pressure_pa(case_json: &str) -> Option<f64> {
+    serde_json::from_str::<serde_json::Value>(case_json).ok()?.pointer("/gas/outlet_pressure_pa")?.as_f64()
+}
+
+/// "what — job name", or just "what" for a job without a name.
+fn titled(what: String, job_name: &str) -> String {
+    if job_name.trim().is_empty() {
+        what
+    } else {
+        format!("{what} — {job_name}")
+    }
+}
+
+/// The field on the axial plane: voidage from 0.3 to 1; pressure as gauge pressure over its range.
+fn field_png(s: &Snapshot, field: SnapshotField, values: Vec<f64>, figure: &Figure) -> Response {
+    let t = format!("t = {:.4} s", s.time_s);
+    let (values, quantity, title, (lo, hi)) = match field {
+        SnapshotField::Pressure => {
+            let p_out = figure.outlet_pa.unwrap_or(0.0);
+            let gauge: Vec<f64> = values.iter().map(|p| p - p_out).collect();
+            let range = min_max(&gauge);
+            let quantity =
+                if figure.outlet_pa.is_some() { "gauge pressure p − p_outlet [Pa]" } else { "pressure p [Pa]" };
+            (gauge, quantity, format!("Gas pressure at {t}"), range)
+        }
+        _ => (values, "voidage ε [-]", format!("Voidage at {t}"), (0.3, 1.0)),
+    };
+    let title = titled(title, &figure.job_name);
+    let labels = plot::FieldLabels { title: &title, quantity, lo, hi };
+    match plot::axial_slice(&s.grid.grid(), &values, &labels) {
+        Ok(img) => bytes("image/png", format!("{}_{:06}.png", name(field), s.index), img.encode()),
+        Err(e) => internal(e.into()),
+    }
+}
+
+fn encode(s: &Snapshot, format: SnapshotFormat, field: SnapshotField, figure: &Figure) -> Response {
     use SnapshotField as F;
     use SnapshotFormat as Fmt;
     let n = s.index;
@@ -191,10 +244,7 @@ fn encode(s: &Snapshot, format: SnapshotFormat, field: SnapshotField) -> Respons
             problem(StatusCode::BAD_REQUEST, "Unknown format", "png draws field=voidage or field=pressure")
         }
         (Fmt::Png, _) => match cell_field(s, field) {
-            Some(f) => {
-                let (lo, hi) = if field == F::Voidage { (0.3, 1.0) } else { min_max(&f) };
-                bytes("image/png", format!("{field_name}_{n:06}.png"), plot::axial_slice(&grid, &f, lo, hi).encode())
-            }
+            Some(f) => field_png(s, field, f, figure),
             None => missing(field_name),
         },
     }
@@ -232,9 +282,10 @@ pub async fn pressure_drop(
     Path(id): Path<String>,
     Query(q): Query<SeriesQuery>,
 ) -> Response {
-    if let Err(r) = find(&app, &id) {
-        return r;
-    }
+    let job = match find(&app, &id) {
+        Ok(j) => j,
+        Err(r) => return r,
+    };
     let rows = match app.store.snapshots(&id) {
         Ok(r) => r,
         Err(e) => return internal(e),
@@ -261,8 +312,17 @@ pub async fn pressure_drop(
                 .iter()
                 .map(|r| if has_dp { r.pressure_drop_pa } else { r.mean_particle_height_m }.unwrap_or(f64::NAN))
                 .collect();
-            let name = if has_dp { "pressure_drop.png" } else { "mean_particle_height.png" };
-            bytes("image/png", name.into(), plot::trace(&t, &y).encode())
+            let (file, title, y_label) = if has_dp {
+                ("pressure_drop.png", "Bed pressure drop", "pressure drop ΔP (bottom to top layer) [Pa]")
+            } else {
+                ("mean_particle_height.png", "Mean particle height", "mean particle-centre height [m]")
+            };
+            let title = titled(title.to_string(), &job.name);
+            let labels = plot::TraceLabels { title: &title, x: "time t [s]", y: y_label };
+            match plot::trace(&t, &y, &labels) {
+                Ok(img) => bytes("image/png", file.into(), img.encode()),
+                Err(e) => internal(e.into()),
+            }
         }
     }
 }
