@@ -1,14 +1,20 @@
-//! A small typed client for the fluidbed HTTP API.
+//! A small typed client for the fluidbed HTTP API: requests and answers are fluidbed-api's
+//! types, the same ones the server serves.
 
 use anyhow::{anyhow, Result};
+use fluidbed_api::{Job, JobList, ListQuery, Problem, SnapshotList};
 use reqwest::{header, Client, StatusCode};
-use serde_json::Value;
+use serde::de::DeserializeOwned;
+use serde::Serialize;
+
+/// For a request without a query string.
+pub const NO_QUERY: &[(&str, &str); 0] = &[];
 
 /// An error the CLI maps to an exit code.
 #[derive(Debug)]
 pub enum ApiError {
     /// 422: the case was refused; the problem document lists each field.
-    Invalid(Value),
+    Invalid(Box<Problem>),
     /// Anything else: connection failures, 4xx/5xx answers.
     Server(String),
 }
@@ -16,7 +22,7 @@ pub enum ApiError {
 impl std::fmt::Display for ApiError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            ApiError::Invalid(p) => write!(f, "invalid case: {}", p["detail"].as_str().unwrap_or("")),
+            ApiError::Invalid(p) => write!(f, "invalid case: {}", p.detail),
             ApiError::Server(m) => write!(f, "{m}"),
         }
     }
@@ -49,22 +55,39 @@ impl Api {
         if status.is_success() {
             return Ok(resp);
         }
-        let body: Value = resp.json().await.unwrap_or(Value::Null);
-        if status == StatusCode::UNPROCESSABLE_ENTITY {
-            return Err(ApiError::Invalid(body));
+        let text = resp.text().await.unwrap_or_default();
+        let problem: Option<Problem> = serde_json::from_str(&text).ok();
+        match problem {
+            Some(p) if status == StatusCode::UNPROCESSABLE_ENTITY => Err(ApiError::Invalid(Box::new(p))),
+            Some(p) => Err(ApiError::Server(format!("server answered {status}: {} {}", p.title, p.detail))),
+            None => Err(ApiError::Server(format!("server answered {status}: {}", text.trim()))),
         }
-        let detail = body["detail"].as_str().unwrap_or("").to_string();
-        Err(ApiError::Server(format!("server answered {status}: {} {detail}", body["title"].as_str().unwrap_or(""))))
     }
 
-    pub async fn get_json(&self, path: &str) -> Result<Value, ApiError> {
-        let r = Self::check(self.http.get(self.url(path)).send().await).await?;
-        r.json().await.map_err(|e| ApiError::Server(format!("bad JSON from server: {e}")))
+    async fn json<T: DeserializeOwned>(resp: reqwest::Response) -> Result<T, ApiError> {
+        resp.json().await.map_err(|e| ApiError::Server(format!("unexpected answer from the server: {e}")))
+    }
+
+    /// GET a JSON document as `T`.
+    pub async fn get<T: DeserializeOwned>(&self, path: &str, query: &impl Serialize) -> Result<T, ApiError> {
+        Self::json(Self::check(self.http.get(self.url(path)).query(query).send().await).await?).await
+    }
+
+    pub async fn job(&self, id: &str) -> Result<Job, ApiError> {
+        self.get(&format!("/v1/jobs/{id}"), NO_QUERY).await
+    }
+
+    pub async fn jobs(&self, query: &ListQuery) -> Result<JobList, ApiError> {
+        self.get("/v1/jobs", query).await
+    }
+
+    pub async fn snapshots(&self, id: &str) -> Result<SnapshotList, ApiError> {
+        self.get(&format!("/v1/jobs/{id}/snapshots"), NO_QUERY).await
     }
 
     /// GET raw bytes; Ok(None) on 404.
-    pub async fn get_bytes(&self, path: &str) -> Result<Option<Vec<u8>>, ApiError> {
-        let r = self.http.get(self.url(path)).send().await;
+    pub async fn get_bytes(&self, path: &str, query: &impl Serialize) -> Result<Option<Vec<u8>>, ApiError> {
+        let r = self.http.get(self.url(path)).query(query).send().await;
         if let Ok(resp) = &r {
             if resp.status() == StatusCode::NOT_FOUND {
                 return Ok(None);
@@ -74,8 +97,8 @@ impl Api {
         r.bytes().await.map(|b| Some(b.to_vec())).map_err(|e| ApiError::Server(format!("download failed: {e}")))
     }
 
-    /// Submit a case (JSON text); the created job.
-    pub async fn submit(&self, case_json: &str) -> Result<Value, ApiError> {
+    /// Submit a case (JSON text, sent as written so that the server sees any key given twice).
+    pub async fn submit(&self, case_json: &str) -> Result<Job, ApiError> {
         let r = self
             .http
             .post(self.url("/v1/jobs"))
@@ -83,13 +106,11 @@ impl Api {
             .body(case_json.to_string())
             .send()
             .await;
-        let r = Self::check(r).await?;
-        r.json().await.map_err(|e| ApiError::Server(format!("bad JSON from server: {e}")))
+        Self::json(Self::check(r).await?).await
     }
 
-    pub async fn cancel(&self, id: &str) -> Result<Value, ApiError> {
-        let r = Self::check(self.http.delete(self.url(&format!("/v1/jobs/{id}"))).send().await).await?;
-        r.json().await.map_err(|e| ApiError::Server(format!("bad JSON from server: {e}")))
+    pub async fn cancel(&self, id: &str) -> Result<Job, ApiError> {
+        Self::json(Self::check(self.http.delete(self.url(&format!("/v1/jobs/{id}"))).send().await).await?).await
     }
 
     pub async fn wait_healthy(&self) -> Result<()> {

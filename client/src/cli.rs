@@ -7,7 +7,8 @@ use crate::outcome::{api_fail, fail, outcome_code, report_outcome};
 use crate::validate::validate;
 use crate::watch::watch;
 use clap::{Parser, Subcommand};
-use serde_json::{json, Value};
+use fluidbed_api::{Job, JobStatus, ListQuery};
+use serde_json::json;
 use std::ffi::OsString;
 use std::path::PathBuf;
 
@@ -91,22 +92,22 @@ pub fn main_with<I: IntoIterator<Item = T>, T: Into<OsString> + Clone>(args: I) 
     rt.block_on(dispatch(cli))
 }
 
-fn print_job(j: &Value, json_out: bool) {
+fn print_job(j: &Job, json_out: bool) {
     if json_out {
-        println!("{j}");
+        println!("{}", serde_json::to_string(j).unwrap_or_default());
     } else {
-        let eta = j["eta_s"].as_f64().map(|e| format!(", ETA {e:.0} s")).unwrap_or_default();
-        let msg = j["message"].as_str().map(|m| format!(" — {m}")).unwrap_or_default();
+        let eta = j.eta_s.map(|e| format!(", ETA {e:.0} s")).unwrap_or_default();
+        let msg = j.message.as_deref().map(|m| format!(" — {m}")).unwrap_or_default();
         println!(
             "{}  {:9}  {:5.1}%  t = {:.4}/{:.4} s  {} steps  {:.1} s wall{eta}  {}{msg}",
-            j["id"].as_str().unwrap_or(""),
-            j["status"].as_str().unwrap_or(""),
-            100.0 * j["progress"].as_f64().unwrap_or(0.0),
-            j["time_s"].as_f64().unwrap_or(0.0),
-            j["end_time_s"].as_f64().unwrap_or(0.0),
-            j["steps"],
-            j["wall_time_s"].as_f64().unwrap_or(0.0),
-            j["name"].as_str().unwrap_or("")
+            j.id,
+            j.status.as_str(),
+            100.0 * j.progress,
+            j.time_s,
+            j.end_time_s,
+            j.steps,
+            j.wall_time_s,
+            j.name
         );
     }
 }
@@ -132,31 +133,39 @@ async fn dispatch(cli: Cli) -> i32 {
             let Some((text, _)) = ok else { return code };
             match api.submit(&text).await {
                 Ok(job) if j => {
-                    println!("{job}");
+                    println!("{}", serde_json::to_string(&job).unwrap_or_default());
                     exit::OK
                 }
                 Ok(job) => {
-                    println!("{}", job["id"].as_str().unwrap_or(""));
+                    println!("{}", job.id);
                     exit::OK
                 }
                 Err(e) => api_fail(e, j),
             }
         }
         Verb::List { status, limit } => {
-            let q = status.map(|s| format!("&status={s}")).unwrap_or_default();
-            match api.get_json(&format!("/v1/jobs?limit={limit}{q}")).await {
-                Ok(v) if j => {
-                    println!("{v}");
+            let status = match status.as_deref().map(|s| JobStatus::parse(s).ok_or(s)).transpose() {
+                Ok(s) => s,
+                Err(s) => {
+                    return fail(
+                        exit::USAGE,
+                        &format!("`{s}` is not a status (queued, running, succeeded, failed, cancelled)"),
+                    )
+                }
+            };
+            match api.jobs(&ListQuery { status, limit: Some(limit as u64), offset: None }).await {
+                Ok(list) if j => {
+                    println!("{}", serde_json::to_string(&list).unwrap_or_default());
                     exit::OK
                 }
-                Ok(v) => {
-                    v["jobs"].as_array().into_iter().flatten().for_each(|job| print_job(job, false));
+                Ok(list) => {
+                    list.jobs.iter().for_each(|job| print_job(job, false));
                     exit::OK
                 }
                 Err(e) => api_fail(e, j),
             }
         }
-        Verb::Status { id } => match api.get_json(&format!("/v1/jobs/{id}")).await {
+        Verb::Status { id } => match api.job(&id).await {
             Ok(v) => {
                 print_job(&v, j);
                 exit::OK
@@ -165,8 +174,8 @@ async fn dispatch(cli: Cli) -> i32 {
         },
         Verb::Watch { id } => match watch(&api, &id, j).await {
             Ok(o) => {
-                report_outcome(&id, &o.status, o.message.as_deref(), j);
-                outcome_code(&o.status)
+                report_outcome(&id, o.status, o.message.as_deref(), j);
+                outcome_code(o.status)
             }
             Err(e) => api_fail(e, j),
         },

@@ -81,7 +81,7 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
         Ok(j) => j,
         Err(e) => return api_fail(e, json_out),
     };
-    let id = job["id"].as_str().unwrap_or("").to_string();
+    let id = job.id;
     if !json_out {
         eprintln!("fluidbed: job {id} submitted");
     }
@@ -94,7 +94,7 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
         Ok(f) => f,
         Err(e) => return api_fail(e, json_out),
     };
-    report_outcome(&id, &outcome.status, outcome.message.as_deref(), false);
+    report_outcome(&id, outcome.status, outcome.message.as_deref(), false);
     if json_out {
         println!(
             "{}",
@@ -103,7 +103,7 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
     } else {
         eprintln!("fluidbed: {} files in {}", files.len(), out.display());
     }
-    outcome_code(&outcome.status)
+    outcome_code(outcome.status)
 }
 
 #[cfg(feature = "embedded")]

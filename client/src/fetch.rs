@@ -3,8 +3,16 @@
 //! for ParaView, and PNGs of the last voidage slice and of the ΔP (or bed-height) trace.
 
 use crate::api::{Api, ApiError};
-use serde_json::Value;
+use fluidbed_api::{SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery};
 use std::path::{Path, PathBuf};
+
+fn snapshot(format: SnapshotFormat, field: Option<SnapshotField>) -> SnapshotQuery {
+    SnapshotQuery { format: Some(format), field, what: None }
+}
+
+fn series(format: SeriesFormat) -> SeriesQuery {
+    SeriesQuery { format: Some(format) }
+}
 
 /// Which encodings to download per snapshot.
 #[derive(Clone, Debug)]
@@ -44,37 +52,40 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
         Ok(())
     };
     let base = format!("/v1/jobs/{id}");
-    if let Some(csv) = api.get_bytes(&format!("{base}/pressure-drop?format=csv")).await? {
+    let pressure_drop = format!("{base}/pressure-drop");
+    if let Some(csv) = api.get_bytes(&pressure_drop, &series(SeriesFormat::Csv)).await? {
         save("pressure_drop.csv".into(), csv)?;
     }
-    let list = api.get_json(&format!("{base}/snapshots")).await?;
-    let snaps: Vec<Value> = list["snapshots"].as_array().cloned().unwrap_or_default();
+    let snaps = api.snapshots(id).await?.snapshots;
     let mut pvd_cells = Vec::new();
     let mut pvd_particles = Vec::new();
     let mut particles_stored = true;
     for s in &snaps {
-        let n = s["n"].as_u64().unwrap_or(0);
-        let t = s["time_s"].as_f64().unwrap_or(0.0);
+        let (n, t) = (s.n, s.time_s);
         let snap = format!("{base}/snapshots/{n}");
         if formats.json {
-            if let Some(b) = api.get_bytes(&format!("{snap}?format=json")).await? {
+            if let Some(b) = api.get_bytes(&snap, &snapshot(SnapshotFormat::Json, None)).await? {
                 save(format!("snapshot_{n:06}.json"), b)?;
             }
         }
         if formats.npy {
-            for field in ["voidage", "pressure", "gas_velocity"] {
-                if let Some(b) = api.get_bytes(&format!("{snap}?format=npy&field={field}")).await? {
-                    save(format!("{field}_{n:06}.npy"), b)?;
+            for (field, name) in [
+                (SnapshotField::Voidage, "voidage"),
+                (SnapshotField::Pressure, "pressure"),
+                (SnapshotField::GasVelocity, "gas_velocity"),
+            ] {
+                if let Some(b) = api.get_bytes(&snap, &snapshot(SnapshotFormat::Npy, Some(field))).await? {
+                    save(format!("{name}_{n:06}.npy"), b)?;
                 }
             }
         }
         if formats.vtk {
-            if let Some(b) = api.get_bytes(&format!("{snap}?format=vtu")).await? {
+            if let Some(b) = api.get_bytes(&snap, &snapshot(SnapshotFormat::Vtu, None)).await? {
                 save(format!("cells_{n:06}.vtu"), b)?;
                 pvd_cells.push((t, format!("cells_{n:06}.vtu")));
             }
             if particles_stored {
-                match api.get_bytes(&format!("{snap}?format=vtp&what=particles")).await? {
+                match api.get_bytes(&snap, &snapshot(SnapshotFormat::Vtp, Some(SnapshotField::Particles))).await? {
                     Some(b) => {
                         save(format!("particles_{n:06}.vtp"), b)?;
                         pvd_particles.push((t, format!("particles_{n:06}.vtp")));
@@ -89,12 +100,13 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
             save(name.into(), pvd(list).into_bytes())?;
         }
     }
-    if let Some(last) = snaps.last().and_then(|s| s["n"].as_u64()) {
-        if let Some(b) = api.get_bytes(&format!("{base}/snapshots/{last}?format=png&field=voidage")).await? {
+    if let Some(last) = snaps.last().map(|s| s.n) {
+        let png = snapshot(SnapshotFormat::Png, Some(SnapshotField::Voidage));
+        if let Some(b) = api.get_bytes(&format!("{base}/snapshots/{last}"), &png).await? {
             save("voidage_last.png".into(), b)?;
         }
-        if let Some(b) = api.get_bytes(&format!("{base}/pressure-drop?format=png")).await? {
-            let has_dp = snaps.iter().any(|s| s["pressure_drop_pa"].is_number());
+        if let Some(b) = api.get_bytes(&pressure_drop, &series(SeriesFormat::Png)).await? {
+            let has_dp = snaps.iter().any(|s| s.pressure_drop_pa.is_some());
             save(if has_dp { "pressure_drop.png" } else { "mean_particle_height.png" }.into(), b)?;
         }
     }

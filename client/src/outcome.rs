@@ -3,6 +3,7 @@
 
 use crate::api::ApiError;
 use crate::exit;
+use fluidbed_api::JobStatus;
 use serde_json::json;
 
 pub(crate) fn fail(code: i32, msg: &str) -> i32 {
@@ -14,16 +15,10 @@ pub(crate) fn api_fail(e: ApiError, json_out: bool) -> i32 {
     match &e {
         ApiError::Invalid(p) => {
             if json_out {
-                println!("{p}");
+                println!("{}", serde_json::to_string(p).unwrap_or_default());
             } else {
-                for err in p["errors"].as_array().into_iter().flatten() {
-                    eprintln!(
-                        "error: {}: {} (got {}; allowed: {})",
-                        err["pointer"].as_str().unwrap_or(""),
-                        err["message"].as_str().unwrap_or(""),
-                        err["value"],
-                        err["allowed"].as_str().unwrap_or("")
-                    );
+                for err in p.errors.iter().flatten() {
+                    eprintln!("error: {}: {} (got {}; allowed: {})", err.pointer, err.message, err.value, err.allowed);
                 }
             }
             exit::INVALID_CASE
@@ -32,15 +27,15 @@ pub(crate) fn api_fail(e: ApiError, json_out: bool) -> i32 {
     }
 }
 
-pub(crate) fn outcome_code(status: &str) -> i32 {
-    if status == "succeeded" {
+pub(crate) fn outcome_code(status: JobStatus) -> i32 {
+    if status == JobStatus::Succeeded {
         exit::OK
     } else {
         exit::JOB_FAILED
     }
 }
 
-pub(crate) fn report_outcome(id: &str, status: &str, message: Option<&str>, json_out: bool) {
+pub(crate) fn report_outcome(id: &str, status: JobStatus, message: Option<&str>, json_out: bool) {
     if json_out {
         println!("{}", json!({ "id": id, "status": status, "message": message }));
     } else {

@@ -2,6 +2,7 @@
 //! lines with `--json`). A dropped connection is resumed with Last-Event-ID.
 
 use crate::api::{Api, ApiError};
+use fluidbed_api::{JobStatus, ProgressEvent, SnapshotEvent, StatusEvent};
 use futures_util::StreamExt;
 use serde_json::Value;
 use std::io::{IsTerminal, Write};
@@ -38,9 +39,9 @@ pub fn parse_events(buf: &mut String) -> Vec<SseEvent> {
     out
 }
 
-/// The final status ("succeeded", "failed", "cancelled") and message.
+/// The final status (succeeded, failed, cancelled) and message.
 pub struct Outcome {
-    pub status: String,
+    pub status: JobStatus,
     pub message: Option<String>,
 }
 
@@ -76,25 +77,24 @@ pub async fn watch(api: &Api, id: &str, json: bool) -> Result<Outcome, ApiError>
                 if ev.id.is_some() {
                     last_id = ev.id.clone();
                 }
-                let data: Value = serde_json::from_str(&ev.data).unwrap_or(Value::Null);
                 if json {
+                    let data: Value = serde_json::from_str(&ev.data).unwrap_or(Value::Null);
                     let mut line = serde_json::json!({ "event": ev.event, "id": ev.id, "data": data });
                     if ev.event == "snapshot" {
                         // Fields are long; scripts fetch them. Keep the scalars.
-                        for k in ["voidage", "pressure_pa", "layer_pressure_drop_pa"] {
+                        for k in ["voidage", "pressure_pa", "layer_pressure_drop_pa", "grid"] {
                             line["data"].as_object_mut().map(|o| o.remove(k));
                         }
                     }
                     println!("{line}");
                 } else {
-                    bar.update(&ev.event, &data);
+                    bar.update(&ev);
                 }
                 if ev.event == "end" {
                     bar.finish();
-                    return Ok(Outcome {
-                        status: data["status"].as_str().unwrap_or("").to_string(),
-                        message: data["message"].as_str().map(str::to_string),
-                    });
+                    let end: StatusEvent = serde_json::from_str(&ev.data)
+                        .map_err(|e| ApiError::Server(format!("unexpected end event `{}`: {e}", ev.data)))?;
+                    return Ok(Outcome { status: end.status, message: end.message });
                 }
             }
         }
@@ -119,47 +119,44 @@ impl Bar {
     fn new(on: bool) -> Bar {
         Bar { on, tty: std::io::stderr().is_terminal(), dp: None, height: None }
     }
-    fn update(&mut self, kind: &str, d: &Value) {
+    fn update(&mut self, ev: &SseEvent) {
         if !self.on {
             return;
         }
-        match kind {
+        match ev.event.as_str() {
             "snapshot" => {
-                self.dp = d["pressure_drop_pa"].as_f64().or(self.dp);
-                self.height = d["mean_particle_height_m"].as_f64().or(self.height);
+                let Ok(d) = serde_json::from_str::<SnapshotEvent>(&ev.data) else { return };
+                self.dp = d.pressure_drop_pa.or(self.dp);
+                self.height = d.mean_particle_height_m.or(self.height);
                 if !self.tty {
-                    eprintln!(
-                        "snapshot {} at t = {:.4} s{}",
-                        d["n"],
-                        d["time_s"].as_f64().unwrap_or(0.0),
-                        self.latest()
-                    );
+                    eprintln!("snapshot {} at t = {:.4} s{}", d.n, d.time_s, self.latest());
                 }
             }
             "progress" if self.tty => {
-                let p = d["progress"].as_f64().unwrap_or(0.0);
-                let filled = (p * 30.0).round() as usize;
-                let eta = d["eta_s"].as_f64().map(|e| format!("ETA {e:.0} s")).unwrap_or_else(|| "ETA ?".into());
+                let Ok(d) = serde_json::from_str::<ProgressEvent>(&ev.data) else { return };
+                let filled = ((d.progress * 30.0).round() as usize).min(30);
+                let eta = d.eta_s.map(|e| format!("ETA {e:.0} s")).unwrap_or_else(|| "ETA ?".into());
                 eprint!(
                     "\r[{}{}] {:5.1}%  t = {:.4}/{:.4} s  {eta}{}   ",
-                    "#".repeat(filled.min(30)),
-                    " ".repeat(30 - filled.min(30)),
-                    100.0 * p,
-                    d["time_s"].as_f64().unwrap_or(0.0),
-                    d["end_time_s"].as_f64().unwrap_or(0.0),
+                    "#".repeat(filled),
+                    " ".repeat(30 - filled),
+                    100.0 * d.progress,
+                    d.time_s,
+                    d.end_time_s,
                     self.latest()
                 );
                 let _ = std::io::stderr().flush();
             }
             "status" => {
-                let m = d["message"].as_str().map(|m| format!(" — {m}")).unwrap_or_default();
+                let Ok(d) = serde_json::from_str::<StatusEvent>(&ev.data) else { return };
+                let m = d.message.map(|m| format!(" — {m}")).unwrap_or_default();
                 if self.tty {
                     if !m.is_empty() {
-                        eprint!("\rstatus: {}{m}   ", d["status"].as_str().unwrap_or("?"));
+                        eprint!("\rstatus: {}{m}   ", d.status);
                         let _ = std::io::stderr().flush();
                     }
                 } else {
-                    eprintln!("status: {}{m}", d["status"].as_str().unwrap_or("?"));
+                    eprintln!("status: {}{m}", d.status);
                 }
             }
             _ => {}

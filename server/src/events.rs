@@ -5,9 +5,11 @@
 use crate::job::SnapshotInfo;
 use crate::App;
 use axum::response::sse::Event;
+pub use fluidbed_api::events::EventKind;
+use fluidbed_api::{GridInfo, SnapshotEvent};
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::snapshot::Snapshot;
-use serde_json::{json, Value};
+use serde::Serialize;
 use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 use tokio::sync::{broadcast, mpsc};
@@ -15,18 +17,19 @@ use tokio::sync::{broadcast, mpsc};
 /// One event as broadcast to live listeners.
 #[derive(Clone, Debug)]
 pub struct JobEvent {
-    pub kind: &'static str,
+    pub kind: EventKind,
     /// The snapshot number of a `snapshot` event.
     pub n: Option<u64>,
     pub data: Arc<String>,
 }
 
 impl JobEvent {
-    pub fn new(kind: &'static str, n: Option<u64>, data: &Value) -> JobEvent {
-        JobEvent { kind, n, data: Arc::new(data.to_string()) }
+    /// An event with `data` as its JSON payload (one of fluidbed-api's event types).
+    pub fn new(kind: EventKind, n: Option<u64>, data: &impl Serialize) -> JobEvent {
+        JobEvent { kind, n, data: Arc::new(serde_json::to_string(data).unwrap_or_else(|_| "null".into())) }
     }
     fn sse(&self) -> Event {
-        let e = Event::default().event(self.kind).data(self.data.as_str());
+        let e = Event::default().event(self.kind.as_str()).data(self.data.as_str());
         match self.n {
             Some(n) => e.id(n.to_string()),
             None => e,
@@ -58,20 +61,20 @@ impl Hub {
 }
 
 /// The `snapshot` event's payload: the grid, cell voidage and pressure, total and per-layer ΔP.
-pub fn snapshot_payload(s: &Snapshot, info: &SnapshotInfo) -> Value {
-    json!({
-        "n": s.index,
-        "time_s": s.time_s,
-        "step": s.step,
-        "cells_per_layer": s.grid.grid().cells_per_layer(),
-        "nz": s.grid.nz,
-        "grid": s.grid,
-        "voidage": fields::voidage(s),
-        "pressure_pa": s.pressure_pa,
-        "pressure_drop_pa": s.pressure_drop_pa,
-        "layer_pressure_drop_pa": s.layer_pressure_drop_pa,
-        "mean_particle_height_m": info.mean_particle_height_m,
-    })
+pub fn snapshot_payload(s: &Snapshot, info: &SnapshotInfo) -> SnapshotEvent {
+    SnapshotEvent {
+        n: s.index,
+        time_s: s.time_s,
+        step: s.step,
+        cells_per_layer: s.grid.grid().cells_per_layer() as u64,
+        nz: s.grid.nz as u64,
+        grid: GridInfo::from(&s.grid),
+        voidage: fields::voidage(s),
+        pressure_pa: s.pressure_pa.clone(),
+        pressure_drop_pa: s.pressure_drop_pa,
+        layer_pressure_drop_pa: s.layer_pressure_drop_pa.clone(),
+        mean_particle_height_m: info.mean_particle_height_m,
+    }
 }
 
 /// Feed one listener: replay what it missed from the store, then follow the live channel.
@@ -79,19 +82,19 @@ pub async fn pump(app: Arc<App>, id: String, last_seen: Option<u64>, tx: mpsc::S
     let mut live = app.hub.subscribe(&id);
     let mut next = last_seen.map_or(0, |n| n + 1);
     let Ok(Some(job)) = app.store.get(&id) else { return };
-    if tx.send(JobEvent::new("status", None, &job.status_json()).sse()).await.is_err() {
+    if tx.send(JobEvent::new(EventKind::Status, None, &job.status_event()).sse()).await.is_err() {
         return;
     }
     if !replay(&app, &id, &mut next, &tx).await {
         return;
     }
     let Ok(Some(job)) = app.store.get(&id) else { return };
-    if tx.send(JobEvent::new("progress", None, &job.progress_json()).sse()).await.is_err() {
+    if tx.send(JobEvent::new(EventKind::Progress, None, &job.progress_event()).sse()).await.is_err() {
         return;
     }
     if job.status.is_final() {
         let _ = replay(&app, &id, &mut next, &tx).await;
-        let _ = tx.send(JobEvent::new("end", None, &job.status_json()).sse()).await;
+        let _ = tx.send(JobEvent::new(EventKind::End, None, &job.status_event()).sse()).await;
         return;
     }
     loop {
@@ -103,7 +106,7 @@ pub async fn pump(app: Arc<App>, id: String, last_seen: Option<u64>, tx: mpsc::S
                     }
                     next = n + 1;
                 }
-                let end = ev.kind == "end";
+                let end = ev.kind == EventKind::End;
                 if tx.send(ev.sse()).await.is_err() || end {
                     return;
                 }
@@ -127,7 +130,7 @@ async fn replay(app: &Arc<App>, id: &str, next: &mut u64, tx: &mpsc::Sender<Even
         let n = info.n;
         let loaded = tokio::task::spawn_blocking(move || a.store.snapshot(&job, n)).await;
         if let Ok(Ok(Some(s))) = loaded {
-            let ev = JobEvent::new("snapshot", Some(n), &snapshot_payload(&s, &info));
+            let ev = JobEvent::new(EventKind::Snapshot, Some(n), &snapshot_payload(&s, &info));
             if tx.send(ev.sse()).await.is_err() {
                 return false;
             }

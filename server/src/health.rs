@@ -2,7 +2,7 @@
 //! later successful probe), whether the reserve (store.rs) is held, and a probe write.
 
 use crate::store::Store;
-use serde_json::{json, Value};
+use fluidbed_api::DataDirReport;
 use std::sync::Mutex;
 
 #[derive(Default)]
@@ -18,7 +18,7 @@ impl Health {
 
     /// Probe the data directory; (healthy, the `data_dir` report). A successful probe sets the
     /// reserve aside again and forgets an earlier failure.
-    pub fn check(&self, store: &Store) -> (bool, Value) {
+    pub fn check(&self, store: &Store) -> (bool, DataDirReport) {
         let dir = store.dir();
         let probe = dir.join(".health-probe");
         let written = std::fs::write(&probe, [0u8; 4096]).and_then(|_| std::fs::remove_file(&probe));
@@ -31,13 +31,13 @@ impl Health {
             }
         }
         let ok = written.is_ok() && store.reserve_held() && last.is_none();
-        let report = json!({
-            "path": dir.display().to_string(),
-            "writable": written.as_ref().map(|_| true).unwrap_or(false),
-            "probe_error": written.err().map(|e| format!("cannot write {}: {e}", probe.display())),
-            "reserve_held": store.reserve_held(),
-            "last_write_error": *last,
-        });
+        let report = DataDirReport {
+            path: dir.display().to_string(),
+            writable: written.is_ok(),
+            probe_error: written.err().map(|e| format!("cannot write {}: {e}", probe.display())),
+            reserve_held: store.reserve_held(),
+            last_write_error: last.clone(),
+        };
         (ok, report)
     }
 }

@@ -1,46 +1,10 @@
-//! A job as the API shows it: status, progress, times, warnings, plan.
+//! A job as the store keeps it, and its views in the API (fluidbed-api's `Job` and events).
 
+use fluidbed_api::{CaseProblem, JobLinks, ProgressEvent, StatusEvent};
 use fluidbed_core::case::Problem;
-use serde::Serialize;
-use serde_json::{json, Value};
+use serde_json::Value;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Status {
-    Queued,
-    Running,
-    Succeeded,
-    Failed,
-    Cancelled,
-}
-
-impl Status {
-    pub const ALL: [Status; 5] =
-        [Status::Queued, Status::Running, Status::Succeeded, Status::Failed, Status::Cancelled];
-
-    pub fn as_str(self) -> &'static str {
-        match self {
-            Status::Queued => "queued",
-            Status::Running => "running",
-            Status::Succeeded => "succeeded",
-            Status::Failed => "failed",
-            Status::Cancelled => "cancelled",
-        }
-    }
-    pub fn parse(s: &str) -> Option<Status> {
-        Some(match s {
-            "queued" => Status::Queued,
-            "running" => Status::Running,
-            "succeeded" => Status::Succeeded,
-            "failed" => Status::Failed,
-            "cancelled" => Status::Cancelled,
-            _ => return None,
-        })
-    }
-    pub fn is_final(self) -> bool {
-        matches!(self, Status::Succeeded | Status::Failed | Status::Cancelled)
-    }
-}
+pub use fluidbed_api::{JobStatus as Status, SnapshotInfo};
 
 #[derive(Clone, Debug)]
 pub struct Job {
@@ -56,22 +20,12 @@ pub struct Job {
     pub wall_s: f64,
     pub eta_s: Option<f64>,
     pub message: Option<String>,
-    pub warnings: Vec<Value>,
+    pub warnings: Vec<CaseProblem>,
     pub plan: Option<Value>,
     /// A DELETE was accepted: the job ends `cancelled` even across a restart.
     pub cancel_requested: bool,
     /// Starts not given back by a clean stop: how often this job went down with its server.
     pub attempts: u32,
-}
-
-/// One row of a job's snapshot index.
-#[derive(Clone, Debug, Serialize)]
-pub struct SnapshotInfo {
-    pub n: u64,
-    pub time_s: f64,
-    pub step: u64,
-    pub pressure_drop_pa: Option<f64>,
-    pub mean_particle_height_m: Option<f64>,
 }
 
 impl Job {
@@ -82,50 +36,47 @@ impl Job {
             _ => 0.0,
         }
     }
-    pub fn to_json(&self) -> Value {
-        json!({
-            "id": self.id,
-            "name": self.name,
-            "status": self.status.as_str(),
-            "created_at": self.created_at,
-            "started_at": self.started_at,
-            "finished_at": self.finished_at,
-            "progress": self.progress(),
-            "time_s": self.time_s,
-            "end_time_s": self.end_time_s,
-            "steps": self.steps,
-            "wall_time_s": self.wall_s,
-            "eta_s": self.eta_s,
-            "message": self.message,
-            "warnings": self.warnings,
-            "plan": self.plan,
-            "links": {
-                "self": format!("/v1/jobs/{}", self.id),
-                "events": format!("/v1/jobs/{}/events", self.id),
-                "snapshots": format!("/v1/jobs/{}/snapshots", self.id),
-                "pressure_drop": format!("/v1/jobs/{}/pressure-drop", self.id),
-            },
-        })
+    /// The job as `GET /v1/jobs/{id}` shows it.
+    pub fn to_api(&self) -> fluidbed_api::Job {
+        fluidbed_api::Job {
+            id: self.id.clone(),
+            name: self.name.clone(),
+            status: self.status,
+            created_at: self.created_at.clone(),
+            started_at: self.started_at.clone(),
+            finished_at: self.finished_at.clone(),
+            progress: self.progress(),
+            time_s: self.time_s,
+            end_time_s: self.end_time_s,
+            steps: self.steps,
+            wall_time_s: self.wall_s,
+            eta_s: self.eta_s,
+            message: self.message.clone(),
+            warnings: self.warnings.clone(),
+            plan: self.plan.clone(),
+            links: JobLinks::of(&self.id),
+        }
     }
     /// The `progress` event's payload.
-    pub fn progress_json(&self) -> Value {
-        json!({
-            "status": self.status.as_str(),
-            "progress": self.progress(),
-            "time_s": self.time_s,
-            "end_time_s": self.end_time_s,
-            "steps": self.steps,
-            "wall_time_s": self.wall_s,
-            "eta_s": self.eta_s,
-        })
+    pub fn progress_event(&self) -> ProgressEvent {
+        ProgressEvent {
+            status: self.status,
+            progress: self.progress(),
+            time_s: self.time_s,
+            end_time_s: self.end_time_s,
+            steps: self.steps,
+            wall_time_s: self.wall_s,
+            eta_s: self.eta_s,
+        }
     }
-    pub fn status_json(&self) -> Value {
-        json!({ "status": self.status.as_str(), "message": self.message })
+    /// The `status` and `end` events' payload.
+    pub fn status_event(&self) -> StatusEvent {
+        StatusEvent { status: self.status, message: self.message.clone() }
     }
 }
 
-pub fn problems_json(p: &[Problem]) -> Vec<Value> {
-    p.iter().map(|p| serde_json::to_value(p).unwrap_or(Value::Null)).collect()
+pub fn case_problems(p: &[Problem]) -> Vec<CaseProblem> {
+    p.iter().map(CaseProblem::from).collect()
 }
 
 /// A new job id: 16 random hex digits (never derived from user input, safe as a folder name).

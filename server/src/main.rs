@@ -17,7 +17,7 @@ struct Args {
     /// Require `Authorization: Bearer TOKEN` on every route but /healthz.
     #[arg(long, env = "FLUIDBED_TOKEN")]
     token: Option<String>,
-    /// Jobs run at once.
+    /// Jobs run at once (0 runs none: jobs are accepted and wait in the queue).
     #[arg(long, default_value_t = 1)]
     workers: usize,
     /// Threads of each job's rayon pool.

@@ -2,7 +2,7 @@
 //! the async runtime. Between chunks of steps it checks for cancellation, stores snapshots,
 //! writes checkpoints atomically, and publishes progress.
 
-use crate::events::{snapshot_payload, JobEvent};
+use crate::events::{snapshot_payload, EventKind, JobEvent};
 use crate::job::{now_rfc3339, SnapshotInfo, Status};
 use crate::metrics::JobRate;
 use crate::App;
@@ -11,7 +11,6 @@ use fluidbed_core::case::Case;
 use fluidbed_core::dem::solver_pool;
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::{Simulation, StageTimers};
-use serde_json::json;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -47,9 +46,9 @@ impl Queue {
     }
 }
 
-/// Start `n` worker threads.
+/// Start `n` worker threads (none for 0: jobs are accepted and wait in the queue).
 pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
-    (0..n.max(1))
+    (0..n)
         .map(|k| {
             let app = app.clone();
             std::thread::Builder::new()
@@ -98,19 +97,19 @@ fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
         return;
     }
     let doc = match app.store.finish(id, status, message, &now_rfc3339()) {
-        Ok(true) => app.store.get(id).ok().flatten().map(|j| j.status_json()),
+        Ok(true) => app.store.get(id).ok().flatten().map(|j| j.status_event()),
         Ok(false) => None,
         Err(e) => {
             let msg = format!("cannot record that job {id} {}: {e:#}", status.as_str());
             tracing::error!("{msg}");
             app.health.write_failed(&msg);
-            Some(json!({ "status": status.as_str(), "message": message }))
+            Some(fluidbed_api::StatusEvent { status, message: message.map(str::to_string) })
         }
     };
     tracing::info!(status = status.as_str(), reason = message, "job ended");
     if let Some(doc) = doc {
-        app.hub.publish(id, JobEvent::new("status", None, &doc));
-        app.hub.publish(id, JobEvent::new("end", None, &doc));
+        app.hub.publish(id, JobEvent::new(EventKind::Status, None, &doc));
+        app.hub.publish(id, JobEvent::new(EventKind::End, None, &doc));
     }
     app.cancels.lock().unwrap_or_else(|e| e.into_inner()).remove(id);
     app.hub.close(id);
@@ -149,7 +148,7 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
     }
     app.store.set_running(id, &now_rfc3339())?;
     if let Some(job) = app.store.get(id)? {
-        app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+        app.hub.publish(id, JobEvent::new(EventKind::Status, None, &job.status_event()));
     }
     let threads = app.config.threads_per_job.max(1);
     // Its own team lock, so that concurrent jobs each step DEM as a team (`team_step`).
@@ -263,7 +262,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
                 last_checkpoint_t = sim.time();
             }
             app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
-            app.hub.publish(id, JobEvent::new("snapshot", Some(s.index), &snapshot_payload(&s, &info)));
+            app.hub.publish(id, JobEvent::new(EventKind::Snapshot, Some(s.index), &snapshot_payload(&s, &info)));
         }
         let stepped = (sim.steps() - steps_start) as f64;
         app.metrics.job_running(id, job_rate(stepped / started.elapsed().as_secs_f64().max(1e-9), sim.timers()));
@@ -271,7 +270,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             last_progress = Instant::now();
             app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
             if let Some(job) = app.store.get(id)? {
-                app.hub.publish(id, JobEvent::new("progress", None, &job.progress_json()));
+                app.hub.publish(id, JobEvent::new(EventKind::Progress, None, &job.progress_event()));
             }
         }
     }
@@ -283,7 +282,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
 fn say(app: &Arc<App>, id: &str, message: Option<&str>) -> Result<()> {
     app.store.set_message(id, message)?;
     if let Some(job) = app.store.get(id)? {
-        app.hub.publish(id, JobEvent::new("status", None, &job.status_json()));
+        app.hub.publish(id, JobEvent::new(EventKind::Status, None, &job.status_event()));
     }
     Ok(())
 }

@@ -175,3 +175,47 @@ pub fn files_under(dir: &Path) -> Vec<PathBuf> {
     out.sort();
     out
 }
+
+/// A decoded PNG: width, height and RGB pixels row by row (8-bit RGB or RGBA; alpha dropped).
+pub struct Picture {
+    pub width: usize,
+    pub height: usize,
+    pub rgb: Vec<[u8; 3]>,
+}
+
+impl Picture {
+    pub fn decode(bytes: &[u8]) -> Picture {
+        let decoder = png::Decoder::new(std::io::Cursor::new(bytes));
+        let mut reader = decoder.read_info().expect("a PNG header");
+        let mut buf = vec![0; reader.output_buffer_size().expect("a buffer size")];
+        let info = reader.next_frame(&mut buf).expect("a PNG frame");
+        assert_eq!(info.bit_depth, png::BitDepth::Eight, "8-bit");
+        let channels = match info.color_type {
+            png::ColorType::Rgb => 3,
+            png::ColorType::Rgba => 4,
+            other => panic!("colour type {other:?}"),
+        };
+        let rgb = buf[..info.buffer_size()].chunks_exact(channels).map(|c| [c[0], c[1], c[2]]).collect();
+        Picture { width: info.width as usize, height: info.height as usize, rgb }
+    }
+    pub fn get(&self, x: usize, y: usize) -> [u8; 3] {
+        self.rgb[y * self.width + x]
+    }
+    /// How many different colours it has (a blank picture has one).
+    pub fn colours(&self) -> usize {
+        let mut c = self.rgb.clone();
+        c.sort_unstable();
+        c.dedup();
+        c.len()
+    }
+    /// The share of pixels that are not white.
+    pub fn inked(&self) -> f64 {
+        self.rgb.iter().filter(|p| **p != [255, 255, 255]).count() as f64 / self.rgb.len() as f64
+    }
+    /// Dark pixels (text, axes) in a band of rows.
+    pub fn dark_in_rows(&self, rows: std::ops::Range<usize>) -> usize {
+        rows.flat_map(|y| (0..self.width).map(move |x| (x, y)))
+            .filter(|&(x, y)| self.get(x, y).iter().all(|&v| v < 110))
+            .count()
+    }
+}

@@ -32,8 +32,10 @@ fn run_with_embedded_server_leaves_csv_npy_vtk_and_png() {
     ] {
         assert!(out.join(f).is_file(), "{f} written");
     }
-    let png = std::fs::read(out.join("voidage_last.png")).unwrap();
-    assert_eq!(&png[1..4], b"PNG");
+    for file in ["voidage_last.png", "mean_particle_height.png"] {
+        let png = Picture::decode(&std::fs::read(out.join(file)).unwrap());
+        assert!(png.width >= 400 && png.height >= 250 && png.colours() > 20, "{file}: {}×{}", png.width, png.height);
+    }
 }
 
 #[test]

@@ -54,8 +54,15 @@ pub fn run() -> serde_json::Value {
         let r = roughness(s, &uz, k_bed);
         let (_, mean_eps) = gradient_and_voidage(s, 1, k_bed);
         eprintln!("{name}: bed voidage {mean_eps:.4}, U_z roughness {r:.3}");
-        crate::plots::slice(s, &uz, 0.0, 0.8, &format!("docs/img/fig3_uz_{name}.png"));
-        crate::plots::slice(s, &eps, 0.3, 1.0, &format!("docs/img/fig3_voidage_{name}.png"));
+        crate::plots::slice(
+            s,
+            &uz,
+            "interstitial gas velocity U_z [m/s]",
+            0.0,
+            0.8,
+            &format!("docs/img/fig3_uz_{name}.png"),
+        );
+        crate::plots::slice(s, &eps, "voidage ε [-]", 0.3, 1.0, &format!("docs/img/fig3_voidage_{name}.png"));
         out.insert(format!("roughness_{name}"), json!(r));
         eps_of.insert(name, mean_eps);
     }

@@ -20,7 +20,7 @@ pub fn run() -> serde_json::Value {
     let rel = mean / want - 1.0;
     eprintln!("{} particles; mean ΔP over {t_avg} ≤ t ≤ {} s = {mean:.1} Pa (σ = {sd:.1} Pa, {} snapshots); bed weight / area less buoyancy {weight:.1} Pa + gas head {head:.2} Pa = {want:.1} Pa; {:+.2}%", r.particles, r.end_s, tail.len(), rel * 100.0);
     let window: Vec<(f64, f64)> = r.dp.iter().copied().filter(|x| x.0 >= t_avg).collect();
-    crate::plots::series_with_level(&window, want, "docs/img/fluidized_dp.png");
+    crate::plots::dp_with_level(&window, want, "docs/img/fluidized_dp.png");
     let mut out = json!({"name": "fluidized", "figure": mean, "reference": want, "rel_err": rel, "std_pa": sd, "bed_weight_pa": weight, "gas_head_pa": head, "particles": r.particles, "t_avg_from_s": t_avg, "end_s": r.end_s});
     let b: Vec<&[f64; 5]> = r.budget.iter().filter(|x| x[0] >= t_avg).collect();
     if b.len() > 1 {
@@ -33,7 +33,12 @@ pub fn run() -> serde_json::Value {
         eprintln!("share of the particles' weight carried, mean over the window: gas {gas:.4}, plate {plate:.4}, tube {tube:.4}; momentum change {inertia:+.4}; unbalanced {:+.4}", gas + plate + tube - inertia - 1.0);
         out["weight_share"] = json!({"gas": gas, "plate": plate, "tube": tube, "momentum_change": inertia});
         let plate_series: Vec<(f64, f64)> = b.iter().map(|x| (x[0], x[1] / weight)).collect();
-        crate::plots::series_with_level(&plate_series, plate, "docs/img/fluidized_plate_share.png");
+        let labels = crate::plots::TraceLabels {
+            title: "Share of the bed's weight carried by the distributor (mean in red)",
+            x: "time t [s]",
+            y: "plate force / bed weight [-]",
+        };
+        crate::plots::series_with_level(&plate_series, plate, &labels, "docs/img/fluidized_plate_share.png");
     }
     out
 }

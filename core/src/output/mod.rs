@@ -1,5 +1,5 @@
-//! Snapshot encoders: .npy arrays, legacy VTK files for ParaView, PNG images (a voidage slice and
-//! a time trace). Snapshots are stored compactly by the server and encoded here on request.
+//! Snapshot encoders: .npy arrays, VTK files for ParaView, PNG figures (a field on the axial
+//! plane and a time trace, drawn with plotters). Snapshots are stored compactly by the server and encoded here on request.
 
 pub mod fields;
 pub mod npy;

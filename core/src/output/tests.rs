@@ -85,9 +85,14 @@ fn axial_slice_shows_lower_voidage_where_particles_are() {
         (0..400).map(|n| [0.0001 * (n % 20) as f64 - 0.001, 0.0001 * (n / 20) as f64, 0.002]).collect();
     let s = snapshot_with_particles(positions);
     let eps = fields::voidage(&s).expect("voidage");
-    let img = plot::axial_slice(&s.grid.grid(), &eps, 0.0, 1.0);
-    let top = img.get(10 + 5, 15);
-    let bottom = img.get(img.width / 2 - 25, img.height - 12);
-    assert_eq!(top, plot::colour(1.0), "empty cells at the top are ε = 1");
-    assert_ne!(bottom, top, "the packed bottom cell on the axis differs");
+    let labels = plot::FieldLabels { title: "t", quantity: "voidage ε [-]", lo: 0.0, hi: 1.0 };
+    let img = plot::axial_slice(&s.grid.grid(), &eps, &labels).expect("drawn");
+    let empty = img.rgb.iter().filter(|p| **p == plot::colour(1.0)).count();
+    let min = eps.iter().cloned().fold(1.0, f64::min);
+    let packed = img.rgb.iter().filter(|p| **p == plot::colour(min)).count();
+    assert!(min < 0.9, "the particles fill a cell ({min})");
+    assert!(
+        empty > 10 * packed && packed > 0,
+        "empty cells are ε = 1 ({empty} px), the packed one shows ({packed} px)"
+    );
 }

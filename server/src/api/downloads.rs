@@ -13,27 +13,34 @@ use axum::extract::{Path, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
+use fluidbed_api::{
+    Binary, PressureDropSeries, SeriesFormat, SeriesQuery, SnapshotDocument, SnapshotField, SnapshotFormat,
+    SnapshotList, SnapshotQuery,
+};
 use fluidbed_core::output::{fields, npy, plot, vtk, vtk_xml};
 use fluidbed_core::sim::snapshot::Snapshot;
-use serde::Deserialize;
-use serde_json::json;
 use std::sync::Arc;
 
+/// The job's snapshots, oldest first.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/snapshots",
+    operation_id = "list_snapshots",
+    tag = "results",
+    params(("id" = String, Path, description = "The job id")),
+    responses(
+        (status = 200, description = "The snapshot index", body = SnapshotList),
+        (status = 404, description = "No such job", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    )
+)]
 pub async fn list(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
     if let Err(r) = find(&app, &id) {
         return r;
     }
     match app.store.snapshots(&id) {
-        Ok(list) => Json(json!({ "snapshots": list })).into_response(),
+        Ok(snapshots) => Json(SnapshotList { snapshots }).into_response(),
         Err(e) => internal(e),
     }
-}
-
-#[derive(Deserialize)]
-pub struct SnapshotQuery {
-    format: Option<String>,
-    field: Option<String>,
-    what: Option<String>,
 }
 
 fn bytes(content_type: &'static str, filename: String, body: Vec<u8>) -> Response {
@@ -50,52 +57,136 @@ fn missing(what: &str) -> Response {
     )
 }
 
+/// One snapshot, encoded as asked.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/snapshots/{n}",
+    operation_id = "get_snapshot",
+    tag = "results",
+    params(
+        ("id" = String, Path, description = "The job id"),
+        ("n" = String, Path, description = "The snapshot number (a plain number; anything else is 404)"),
+        SnapshotQuery,
+    ),
+    responses(
+        (status = 200, description = "The snapshot", content(
+            (SnapshotDocument = "application/json"),
+            (Binary = "application/octet-stream"),
+            (String = "text/plain"),
+            (String = "application/xml"),
+            (Binary = "image/png"),
+        )),
+        (status = 400, description = "A bad query string", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 404, description = "No such job or snapshot, or the field is not stored", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
+    )
+)]
 pub async fn one(
     State(app): State<Arc<App>>,
     Path((id, n)): Path<(String, String)>,
     Query(q): Query<SnapshotQuery>,
 ) -> Response {
-    if let Err(r) = find(&app, &id) {
-        return r;
-    }
+    let job = match find(&app, &id) {
+        Ok(j) => j,
+        Err(r) => return r,
+    };
     // Only a plain number names a snapshot; anything else (`..`, `/`) is simply not found.
     let Some(n) = n.parse::<u64>().ok().filter(|_| n.bytes().all(|b| b.is_ascii_digit())) else {
         return problem(StatusCode::NOT_FOUND, "Not found", "no such snapshot");
     };
     let a = app.clone();
-    let snap = match tokio::task::spawn_blocking(move || a.store.snapshot(&id, n)).await {
+    let job_id = id.clone();
+    let snap = match tokio::task::spawn_blocking(move || a.store.snapshot(&job_id, n)).await {
         Ok(Ok(Some(s))) => s,
         Ok(Ok(None)) => return problem(StatusCode::NOT_FOUND, "Not found", "no such snapshot"),
         Ok(Err(e)) => return internal(e),
         Err(e) => return internal(e.into()),
     };
-    let format = q.format.unwrap_or_else(|| "json".into());
-    let what = q.what.or(q.field).unwrap_or_else(|| "voidage".into());
-    match tokio::task::spawn_blocking(move || encode(&snap, &format, &what)).await {
+    let (format, field) = (q.format.unwrap_or(SnapshotFormat::Json), q.field());
+    // A picture of the pressure shows it as gauge pressure, against the case's outlet pressure.
+    let outlet_pa = match (format, field) {
+        (SnapshotFormat::Png, SnapshotField::Pressure) => match app.store.case_json(&id) {
+            Ok(text) => text.and_then(|t| outlet_pressure_pa(&t)),
+            Err(e) => return internal(e),
+        },
+        _ => None,
+    };
+    let figure = Figure { job_name: job.name, outlet_pa };
+    match tokio::task::spawn_blocking(move || encode(&snap, format, field, &figure)).await {
         Ok(r) => r,
         Err(e) => internal(e.into()),
     }
 }
 
-fn cell_field(s: &Snapshot, what: &str) -> Option<Vec<f64>> {
-    match what {
-        "voidage" | "cells" => fields::voidage(s),
-        "pressure" | "pressure_pa" => s.pressure_pa.clone(),
-        _ => None,
+fn cell_field(s: &Snapshot, field: SnapshotField) -> Option<Vec<f64>> {
+    match field {
+        SnapshotField::Voidage => fields::voidage(s),
+        SnapshotField::Pressure => s.pressure_pa.clone(),
+        SnapshotField::GasVelocity | SnapshotField::Particles => None,
     }
 }
 
-fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
+/// The field's name in file names and messages.
+fn name(field: SnapshotField) -> &'static str {
+    match field {
+        SnapshotField::Voidage => "voidage",
+        SnapshotField::Pressure => "pressure",
+        SnapshotField::GasVelocity => "gas_velocity",
+        SnapshotField::Particles => "particles",
+    }
+}
+
+/// What a snapshot's picture needs beside the snapshot.
+struct Figure {
+    job_name: String,
+    /// The case's `gas.outlet_pressure_pa`, the zero of the gauge pressure.
+    outlet_pa: Option<f64>,
+}
+
+fn outlet_pressure_pa(case_json: &str) -> Option<f64> {
+    serde_json::from_str::<serde_json::Value>(case_json).ok()?.pointer("/gas/outlet_pressure_pa")?.as_f64()
+}
+
+/// "what — job name", or just "what" for a job without a name.
+fn titled(what: String, job_name: &str) -> String {
+    if job_name.trim().is_empty() {
+        what
+    } else {
+        format!("{what} — {job_name}")
+    }
+}
+
+/// The field on the axial plane: voidage from 0.3 to 1; pressure as gauge pressure over its range.
+fn field_png(s: &Snapshot, field: SnapshotField, values: Vec<f64>, figure: &Figure) -> Response {
+    let t = format!("t = {:.4} s", s.time_s);
+    let (values, quantity, title, (lo, hi)) = match field {
+        SnapshotField::Pressure => {
+            let p_out = figure.outlet_pa.unwrap_or(0.0);
+            let gauge: Vec<f64> = values.iter().map(|p| p - p_out).collect();
+            let range = min_max(&gauge);
+            let quantity =
+                if figure.outlet_pa.is_some() { "gauge pressure p − p_outlet [Pa]" } else { "pressure p [Pa]" };
+            (gauge, quantity, format!("Gas pressure at {t}"), range)
+        }
+        _ => (values, "voidage ε [-]", format!("Voidage at {t}"), (0.3, 1.0)),
+    };
+    let title = titled(title, &figure.job_name);
+    let labels = plot::FieldLabels { title: &title, quantity, lo, hi };
+    match plot::axial_slice(&s.grid.grid(), &values, &labels) {
+        Ok(img) => bytes("image/png", format!("{}_{:06}.png", name(field), s.index), img.encode()),
+        Err(e) => internal(e.into()),
+    }
+}
+
+fn encode(s: &Snapshot, format: SnapshotFormat, field: SnapshotField, figure: &Figure) -> Response {
+    use SnapshotField as F;
+    use SnapshotFormat as Fmt;
     let n = s.index;
     let grid = s.grid.grid();
-    let field_name = if what == "cells" { "voidage" } else { what };
-    match format {
-        "json" => {
-            let mut v = serde_json::to_value(s).unwrap_or_default();
-            v["voidage"] = json!(fields::voidage(s));
-            Json(v).into_response()
-        }
-        "npy" if what == "particles" => match &s.particles {
+    let field_name = name(field);
+    match (format, field) {
+        (Fmt::Json, _) => Json(SnapshotDocument::of(s)).into_response(),
+        (Fmt::Npy, F::Particles) => match &s.particles {
             Some(p) => {
                 let data: Vec<f64> = p
                     .positions_m
@@ -111,7 +202,7 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             }
             None => missing("particles"),
         },
-        "npy" if what == "gas_velocity" => match &s.gas_velocity_m_s {
+        (Fmt::Npy, F::GasVelocity) => match &s.gas_velocity_m_s {
             Some(u) => bytes(
                 "application/octet-stream",
                 format!("gas_velocity_{n:06}.npy"),
@@ -122,15 +213,15 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             ),
             None => missing("gas_velocity"),
         },
-        "npy" => match cell_field(s, what) {
+        (Fmt::Npy, _) => match cell_field(s, field) {
             Some(f) => bytes(
                 "application/octet-stream",
                 format!("{field_name}_{n:06}.npy"),
                 npy::encode_f64(&[grid.nz, grid.cells_per_layer()], &f),
             ),
-            None => missing(what),
+            None => missing(field_name),
         },
-        "vtk" if what == "particles" => match &s.particles {
+        (Fmt::Vtk, F::Particles) => match &s.particles {
             Some(p) => bytes(
                 "text/plain",
                 format!("particles_{n:06}.vtk"),
@@ -138,20 +229,24 @@ fn encode(s: &Snapshot, format: &str, what: &str) -> Response {
             ),
             None => missing("particles"),
         },
-        "vtk" => bytes("text/plain", format!("cells_{n:06}.vtk"), vtk::snapshot_cells(s).into_bytes()),
-        "vtp" | "vtu" if what == "particles" => match &s.particles {
+        (Fmt::Vtk, _) => bytes("text/plain", format!("cells_{n:06}.vtk"), vtk::snapshot_cells(s).into_bytes()),
+        (Fmt::Vtp | Fmt::Vtu, F::Particles) => match &s.particles {
             Some(p) => bytes("application/xml", format!("particles_{n:06}.vtp"), vtk_xml::particles(p)),
             None => missing("particles"),
         },
-        "vtu" => bytes("application/xml", format!("cells_{n:06}.vtu"), vtk_xml::snapshot_cells(s)),
-        "png" => match cell_field(s, what) {
-            Some(f) => {
-                let (lo, hi) = if field_name == "voidage" { (0.3, 1.0) } else { min_max(&f) };
-                bytes("image/png", format!("{field_name}_{n:06}.png"), plot::axial_slice(&grid, &f, lo, hi).encode())
-            }
-            None => missing(what),
+        (Fmt::Vtu, _) => bytes("application/xml", format!("cells_{n:06}.vtu"), vtk_xml::snapshot_cells(s)),
+        (Fmt::Vtp, _) => problem(
+            StatusCode::BAD_REQUEST,
+            "Unknown format",
+            "vtp holds the particles (field=particles); the cells are vtu",
+        ),
+        (Fmt::Png, F::GasVelocity | F::Particles) => {
+            problem(StatusCode::BAD_REQUEST, "Unknown format", "png draws field=voidage or field=pressure")
+        }
+        (Fmt::Png, _) => match cell_field(s, field) {
+            Some(f) => field_png(s, field, f, figure),
+            None => missing(field_name),
         },
-        _ => problem(StatusCode::BAD_REQUEST, "Unknown format", "format is one of json, npy, vtk, vtu, vtp, png"),
     }
 }
 
@@ -164,50 +259,70 @@ fn min_max(v: &[f64]) -> (f64, f64) {
     }
 }
 
-#[derive(Deserialize)]
-pub struct SeriesQuery {
-    format: Option<String>,
-}
-
 /// One row per snapshot: time_s, pressure_drop_pa (empty for runs without gas) and the mean
 /// particle-centre height (the bed-height proxy used for the plot of runs without gas).
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/pressure-drop",
+    operation_id = "get_pressure_drop",
+    tag = "results",
+    params(("id" = String, Path, description = "The job id"), SeriesQuery),
+    responses(
+        (status = 200, description = "The series", content(
+            (PressureDropSeries = "application/json"),
+            (String = "text/csv"),
+            (Binary = "image/png"),
+        )),
+        (status = 400, description = "A bad query string", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 404, description = "No such job", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    )
+)]
 pub async fn pressure_drop(
     State(app): State<Arc<App>>,
     Path(id): Path<String>,
     Query(q): Query<SeriesQuery>,
 ) -> Response {
-    if let Err(r) = find(&app, &id) {
-        return r;
-    }
+    let job = match find(&app, &id) {
+        Ok(j) => j,
+        Err(r) => return r,
+    };
     let rows = match app.store.snapshots(&id) {
         Ok(r) => r,
         Err(e) => return internal(e),
     };
     let opt = |x: Option<f64>| x.map(|v| v.to_string()).unwrap_or_default();
-    match q.format.as_deref().unwrap_or("json") {
-        "csv" => {
+    match q.format.unwrap_or(SeriesFormat::Json) {
+        SeriesFormat::Csv => {
             let mut out = String::from("time_s,pressure_drop_pa,mean_particle_height_m\n");
             for r in &rows {
                 out.push_str(&format!("{},{},{}\n", r.time_s, opt(r.pressure_drop_pa), opt(r.mean_particle_height_m)));
             }
             bytes("text/csv", "pressure_drop.csv".into(), out.into_bytes())
         }
-        "json" => Json(json!({
-            "time_s": rows.iter().map(|r| r.time_s).collect::<Vec<_>>(),
-            "pressure_drop_pa": rows.iter().map(|r| r.pressure_drop_pa).collect::<Vec<_>>(),
-            "mean_particle_height_m": rows.iter().map(|r| r.mean_particle_height_m).collect::<Vec<_>>(),
-        }))
+        SeriesFormat::Json => Json(PressureDropSeries {
+            time_s: rows.iter().map(|r| r.time_s).collect(),
+            pressure_drop_pa: rows.iter().map(|r| r.pressure_drop_pa).collect(),
+            mean_particle_height_m: rows.iter().map(|r| r.mean_particle_height_m).collect(),
+        })
         .into_response(),
-        "png" => {
+        SeriesFormat::Png => {
             let t: Vec<f64> = rows.iter().map(|r| r.time_s).collect();
             let has_dp = rows.iter().any(|r| r.pressure_drop_pa.is_some());
             let y: Vec<f64> = rows
                 .iter()
                 .map(|r| if has_dp { r.pressure_drop_pa } else { r.mean_particle_height_m }.unwrap_or(f64::NAN))
                 .collect();
-            let name = if has_dp { "pressure_drop.png" } else { "mean_particle_height.png" };
-            bytes("image/png", name.into(), plot::trace(&t, &y).encode())
+            let (file, title, y_label) = if has_dp {
+                ("pressure_drop.png", "Bed pressure drop", "pressure drop ΔP (bottom to top layer) [Pa]")
+            } else {
+                ("mean_particle_height.png", "Mean particle height", "mean particle-centre height [m]")
+            };
+            let title = titled(title.to_string(), &job.name);
+            let labels = plot::TraceLabels { title: &title, x: "time t [s]", y: y_label };
+            match plot::trace(&t, &y, &labels) {
+                Ok(img) => bytes("image/png", file.into(), img.encode()),
+                Err(e) => internal(e.into()),
+            }
         }
-        _ => problem(StatusCode::BAD_REQUEST, "Unknown format", "format is one of csv, json, png"),
     }
 }

@@ -1,8 +1,8 @@
 //! Job routes: create, list, status, cancel, event stream.
 
-use super::problem::{internal, no_job, problem, problem_with};
-use crate::events::{pump, JobEvent};
-use crate::job::{new_id, now_rfc3339, plausible_id, problems_json, Job, Status};
+use super::problem::{internal, no_job, problem, respond};
+use crate::events::{pump, EventKind, JobEvent};
+use crate::job::{case_problems, new_id, now_rfc3339, plausible_id, Job, Status};
 use crate::worker::cancel_flag;
 use crate::App;
 use axum::body::Bytes;
@@ -12,16 +12,39 @@ use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::sse::{Event, KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
+use fluidbed_api::query::{MAX_LIMIT, MAX_OFFSET};
+use fluidbed_api::{EventsQuery, FieldError, JobList, ListQuery};
 use fluidbed_core::case::bounds::CaseSize;
 use fluidbed_core::case::strict_json::{self, StrictJsonError};
 use fluidbed_core::case::{Case, Problem, Severity};
-use serde::Deserialize;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::convert::Infallible;
 use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Duration;
 
+/// Submit a case; it is validated at once.
+#[utoipa::path(
+    post,
+    path = "/v1/jobs",
+    operation_id = "create_job",
+    tag = "jobs",
+    request_body(
+        content = ref("#/components/schemas/Case"),
+        content_type = "application/json",
+        description = "A case (the schema is also served at /v1/schema/case). A key given twice is refused."
+    ),
+    responses(
+        (status = 201, description = "Created", body = fluidbed_api::Job,
+            headers(("Location" = String, description = "/v1/jobs/{id}"))),
+        (status = 400, description = "Not JSON", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 413, description = "Over --max-body-bytes", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 422, description = "Invalid case: `errors` names every field", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
+        (status = 429, description = "Too many submissions or a full queue", body = fluidbed_api::Problem,
+            content_type = "application/problem+json", headers(("Retry-After" = String, description = "seconds"))),
+    )
+)]
 pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesRejection>) -> Response {
     let body = match body {
         Ok(b) => b,
@@ -95,7 +118,7 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
         wall_s: 0.0,
         eta_s: None,
         message: None,
-        warnings: problems_json(&report.warnings),
+        warnings: case_problems(&report.warnings),
         plan: None,
         cancel_requested: false,
         attempts: 0,
@@ -109,50 +132,31 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
     }
     app.queue.push(job.id.clone());
     let location = format!("/v1/jobs/{}", job.id);
-    (StatusCode::CREATED, [(header::LOCATION, location)], Json(job.to_json())).into_response()
+    (StatusCode::CREATED, [(header::LOCATION, location)], Json(job.to_api())).into_response()
 }
 
 /// 422 with every problem named by its JSON pointer.
 fn invalid_case(errors: &[Problem], warnings: &[Problem]) -> Response {
-    let list: Vec<_> = errors
-        .iter()
-        .map(|p| json!({"pointer": p.path, "value": p.value, "allowed": p.allowed, "message": p.message}))
-        .collect();
     let detail = errors.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ");
-    problem_with(
-        StatusCode::UNPROCESSABLE_ENTITY,
-        "Invalid case",
-        &detail,
-        json!({ "errors": list, "warnings": problems_json(warnings) }),
+    let mut doc = fluidbed_api::Problem::new(422, "Invalid case", &detail);
+    doc.errors = Some(errors.iter().map(FieldError::from).collect());
+    doc.warnings = Some(case_problems(warnings));
+    respond(&doc)
+}
+
+/// List jobs, newest first.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs",
+    operation_id = "list_jobs",
+    tag = "jobs",
+    params(ListQuery),
+    responses(
+        (status = 200, description = "One page of jobs", body = JobList),
+        (status = 400, description = "A bad query string", body = fluidbed_api::Problem, content_type = "application/problem+json"),
     )
-}
-
-#[derive(Deserialize)]
-pub struct ListQuery {
-    status: Option<String>,
-    limit: Option<u64>,
-    offset: Option<u64>,
-}
-
-/// Largest page of the job list.
-const MAX_LIMIT: u64 = 500;
-/// Offsets and event ids are stored as SQLite integers (i64).
-const MAX_OFFSET: u64 = i64::MAX as u64;
-
+)]
 pub async fn list(State(app): State<Arc<App>>, Query(q): Query<ListQuery>) -> Response {
-    let status = match q.status.as_deref() {
-        None | Some("") => None,
-        Some(s) => match Status::parse(s) {
-            Some(st) => Some(st),
-            None => {
-                return problem(
-                    StatusCode::BAD_REQUEST,
-                    "Bad status filter",
-                    "status is one of queued, running, succeeded, failed, cancelled",
-                )
-            }
-        },
-    };
     let (limit, offset) = (q.limit.unwrap_or(50), q.offset.unwrap_or(0));
     if !(1..=MAX_LIMIT).contains(&limit) {
         return problem(StatusCode::BAD_REQUEST, "Bad limit", &format!("limit is from 1 to {MAX_LIMIT} (got {limit})"));
@@ -164,14 +168,17 @@ pub async fn list(State(app): State<Arc<App>>, Query(q): Query<ListQuery>) -> Re
             &format!("offset is from 0 to {MAX_OFFSET} (got {offset})"),
         );
     }
-    let (limit, offset) = (limit as usize, offset as usize);
-    match app.store.list(status, limit, offset) {
+    match app.store.list(q.status, limit as usize, offset as usize) {
         Ok((jobs, total)) => {
-            let next = (offset + jobs.len() < total).then_some(offset + jobs.len());
-            Json(json!({
-                "jobs": jobs.iter().map(Job::to_json).collect::<Vec<_>>(),
-                "total": total, "limit": limit, "offset": offset, "next_offset": next,
-            }))
+            let end = offset + jobs.len() as u64;
+            let total = total as u64;
+            Json(JobList {
+                jobs: jobs.iter().map(Job::to_api).collect(),
+                total,
+                limit,
+                offset,
+                next_offset: (end < total).then_some(end),
+            })
             .into_response()
         }
         Err(e) => internal(e),
@@ -191,14 +198,41 @@ pub fn find(app: &App, id: &str) -> Result<Job, Response> {
     }
 }
 
+/// One job: status, progress, ETA.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}",
+    operation_id = "get_job",
+    tag = "jobs",
+    params(("id" = String, Path, description = "The job id")),
+    responses(
+        (status = 200, description = "The job", body = fluidbed_api::Job),
+        (status = 404, description = "No such job", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    )
+)]
 pub async fn get_one(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
     match find(&app, &id) {
-        Ok(job) => Json(job.to_json()).into_response(),
+        Ok(job) => Json(job.to_api()).into_response(),
         Err(r) => r,
     }
 }
 
-/// Cancel: a queued job ends at once; a running one stops at its next chunk boundary.
+/// Cancel: a queued job ends at once; a running one stops at its next chunk, a bed being poured
+/// at once. The cancel is stored before the answer, so it holds across a server stop.
+#[utoipa::path(
+    delete,
+    path = "/v1/jobs/{id}",
+    operation_id = "cancel_job",
+    tag = "jobs",
+    params(("id" = String, Path, description = "The job id")),
+    responses(
+        (status = 202, description = "Cancel accepted", body = fluidbed_api::Job),
+        (status = 200, description = "Already cancelled", body = fluidbed_api::Job),
+        (status = 404, description = "No such job", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 409, description = "The job already succeeded or failed", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
+    )
+)]
 pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
     let job = match find(&app, &id) {
         Ok(j) => j,
@@ -212,7 +246,7 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
                 &format!("the job has {}", job.status.as_str()),
             )
         }
-        Status::Cancelled => return Json(job.to_json()).into_response(),
+        Status::Cancelled => return Json(job.to_api()).into_response(),
         Status::Queued | Status::Running => {}
     }
     // Stored before the answer, so that a cancel survives a server stop.
@@ -228,21 +262,16 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
         if let Ok(true) = app.store.finish(&id, Status::Cancelled, Some("cancelled before it started"), &now_rfc3339())
         {
             if let Ok(Some(j)) = app.store.get(&id) {
-                app.hub.publish(&id, JobEvent::new("status", None, &j.status_json()));
-                app.hub.publish(&id, JobEvent::new("end", None, &j.status_json()));
+                app.hub.publish(&id, JobEvent::new(EventKind::Status, None, &j.status_event()));
+                app.hub.publish(&id, JobEvent::new(EventKind::End, None, &j.status_event()));
             }
         }
     }
     match app.store.get(&id) {
-        Ok(Some(j)) => (StatusCode::ACCEPTED, Json(j.to_json())).into_response(),
+        Ok(Some(j)) => (StatusCode::ACCEPTED, Json(j.to_api())).into_response(),
         Ok(None) => no_job(),
         Err(e) => internal(e),
     }
-}
-
-#[derive(Deserialize)]
-pub struct EventsQuery {
-    last_event_id: Option<String>,
 }
 
 /// A Last-Event-ID: a snapshot number up to MAX_OFFSET (the next one is then n + 1).
@@ -258,7 +287,26 @@ fn last_event_id(text: &str) -> Result<u64, Response> {
     }
 }
 
-/// Server-sent events; resume with the `Last-Event-ID` header (or `?last_event_id=`).
+/// Server-sent events: `status` and `progress` (StatusEvent, ProgressEvent), `snapshot` with
+/// `id: n` (SnapshotEvent), and `end` (StatusEvent), after which the stream closes. A late client
+/// first gets every stored snapshot; resume with `Last-Event-ID: n` to get only those after n.
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/events",
+    operation_id = "job_events",
+    tag = "jobs",
+    params(
+        ("id" = String, Path, description = "The job id"),
+        ("Last-Event-ID" = Option<String>, Header, description = "The last snapshot number seen (0 to 2^63 - 2)"),
+        EventsQuery,
+    ),
+    responses(
+        (status = 200, description = "The event stream; each event is a JobStreamEvent",
+            body = ref("#/components/schemas/JobStreamEvent"), content_type = "text/event-stream"),
+        (status = 400, description = "A bad Last-Event-ID", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 404, description = "No such job", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    )
+)]
 pub async fn events(
     State(app): State<Arc<App>>,
     Path(id): Path<String>,

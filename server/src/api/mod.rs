@@ -1,7 +1,10 @@
-//! The HTTP API, versioned under /v1 (see docs/API.md and GET /openapi.json).
+//! The HTTP API, versioned under /v1 (see docs/API.md and GET /openapi.json). Every route is
+//! registered through utoipa-axum from its handler's `#[utoipa::path]`, so the OpenAPI document
+//! (openapi.rs) lists exactly what is routed.
 
 mod downloads;
 mod jobs;
+pub mod openapi;
 pub mod problem;
 
 use crate::App;
@@ -9,28 +12,35 @@ use axum::extract::{DefaultBodyLimit, Request, State};
 use axum::http::{header, StatusCode};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
-use axum::routing::get;
 use axum::{Json, Router};
+use fluidbed_api::{Health, HealthStatus};
 use problem::problem;
 use std::sync::Arc;
 use tower_http::timeout::{RequestBodyTimeoutLayer, TimeoutLayer};
+use utoipa::OpenApi;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
 
-pub const OPENAPI: &str = include_str!("openapi.json");
+/// Every route with its OpenAPI operation (the page's included).
+pub fn routes() -> OpenApiRouter<Arc<App>> {
+    OpenApiRouter::with_openapi(openapi::ApiDoc::openapi())
+        .routes(routes!(jobs::list, jobs::create))
+        .routes(routes!(jobs::get_one, jobs::cancel))
+        .routes(routes!(jobs::events))
+        .routes(routes!(downloads::list))
+        .routes(routes!(downloads::one))
+        .routes(routes!(downloads::pressure_drop))
+        .routes(routes!(schema))
+        .routes(routes!(openapi::serve))
+        .routes(routes!(healthz))
+        .routes(routes!(crate::metrics::handler))
+        .merge(crate::page::routes())
+}
 
 pub fn router(app: Arc<App>) -> Router {
     let limit = app.config.max_body_bytes;
-    Router::new()
-        .route("/v1/jobs", get(jobs::list).post(jobs::create))
-        .route("/v1/jobs/{id}", get(jobs::get_one).delete(jobs::cancel))
-        .route("/v1/jobs/{id}/events", get(jobs::events))
-        .route("/v1/jobs/{id}/snapshots", get(downloads::list))
-        .route("/v1/jobs/{id}/snapshots/{n}", get(downloads::one))
-        .route("/v1/jobs/{id}/pressure-drop", get(downloads::pressure_drop))
-        .route("/v1/schema/case", get(schema))
-        .route("/openapi.json", get(openapi))
-        .route("/healthz", get(healthz))
-        .route("/metrics", get(crate::metrics::handler))
-        .merge(crate::page::routes())
+    let (routes, _) = routes().split_for_parts();
+    routes
         .fallback(not_found)
         .layer(axum::middleware::from_fn_with_state(app.clone(), auth))
         .layer(DefaultBodyLimit::max(limit))
@@ -41,28 +51,34 @@ pub fn router(app: Arc<App>) -> Router {
         .with_state(app)
 }
 
-/// 200 while the data directory takes writes; 503 with the cause (a full or read-only disk).
+/// Liveness: 200 while the data directory takes writes; 503 with the cause (a full or read-only
+/// disk). Never needs the token.
+#[utoipa::path(get, path = "/healthz", operation_id = "health", tag = "meta", security(()),
+    responses(
+        (status = 200, description = "Healthy", body = Health),
+        (status = 503, description = "The data directory takes no writes", body = Health),
+    ))]
 async fn healthz(State(app): State<Arc<App>>) -> Response {
     let a = app.clone();
     let (ok, data_dir) = match tokio::task::spawn_blocking(move || a.health.check(&a.store)).await {
         Ok(r) => r,
         Err(e) => return problem::internal(e.into()),
     };
-    let body = serde_json::json!({
-        "status": if ok { "ok" } else { "degraded" },
-        "version": env!("CARGO_PKG_VERSION"),
-        "data_dir": data_dir,
-    });
+    let body = Health {
+        status: if ok { HealthStatus::Ok } else { HealthStatus::Degraded },
+        version: env!("CARGO_PKG_VERSION").to_string(),
+        data_dir,
+    };
     let code = if ok { StatusCode::OK } else { StatusCode::SERVICE_UNAVAILABLE };
     (code, Json(body)).into_response()
 }
 
+/// The case JSON Schema (draft 7, also docs/case.schema.json; the same schema is the
+/// `Case` component of this document).
+#[utoipa::path(get, path = "/v1/schema/case", operation_id = "get_case_schema", tag = "meta",
+    responses((status = 200, description = "A JSON Schema", body = Object)))]
 async fn schema() -> Json<serde_json::Value> {
     Json(fluidbed_core::case::Case::json_schema())
-}
-
-async fn openapi() -> Response {
-    ([(header::CONTENT_TYPE, "application/json")], OPENAPI).into_response()
 }
 
 async fn not_found() -> Response {

@@ -4,24 +4,17 @@ use axum::extract::Request;
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
-use serde_json::{json, Value};
+use fluidbed_api::Problem;
 
 pub fn problem(status: StatusCode, title: &str, detail: &str) -> Response {
-    problem_with(status, title, detail, json!({}))
+    respond(&Problem::new(status.as_u16(), title, detail))
 }
 
-/// A problem with extension members (e.g. `errors`), merged into the body.
-pub fn problem_with(status: StatusCode, title: &str, detail: &str, extra: Value) -> Response {
-    let mut body = json!({
-        "type": "about:blank",
-        "title": title,
-        "status": status.as_u16(),
-        "detail": detail,
-    });
-    if let (Some(b), Value::Object(e)) = (body.as_object_mut(), extra) {
-        b.extend(e);
-    }
-    (status, [(header::CONTENT_TYPE, "application/problem+json")], body.to_string()).into_response()
+/// A problem document as the answer, with its own status.
+pub fn respond(p: &Problem) -> Response {
+    let status = StatusCode::from_u16(p.status).unwrap_or(StatusCode::INTERNAL_SERVER_ERROR);
+    let body = serde_json::to_string(p).unwrap_or_default();
+    (status, [(header::CONTENT_TYPE, "application/problem+json")], body).into_response()
 }
 
 pub fn internal(e: anyhow::Error) -> Response {

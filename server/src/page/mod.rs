@@ -6,8 +6,8 @@
 use axum::extract::Path;
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
-use axum::routing::get;
-use axum::Router;
+use utoipa_axum::router::OpenApiRouter;
+use utoipa_axum::routes;
 
 /// Files under `/ui/`: name, content type, content.
 const ASSETS: &[(&str, &str, &str)] = &[
@@ -36,12 +36,23 @@ const JOB_HTML: &str = include_str!("assets/job.html");
 
 /// The page's routes; none needs the bearer token (the files hold no data: the scripts ask for
 /// the token when the API answers 401).
-pub fn routes<S: Clone + Send + Sync + 'static>() -> Router<S> {
-    Router::new()
-        .route("/", get(|| async { html(INDEX_HTML) }))
-        .route("/jobs/{id}", get(|Path(_id): Path<String>| async { html(JOB_HTML) }))
-        .route("/ui/cases.json", get(cases))
-        .route("/ui/{file}", get(asset))
+pub fn routes<S: Clone + Send + Sync + 'static>() -> OpenApiRouter<S> {
+    OpenApiRouter::new().routes(routes!(index)).routes(routes!(job_page)).routes(routes!(cases)).routes(routes!(asset))
+}
+
+/// The live page: the job list and the submit form.
+#[utoipa::path(get, path = "/", operation_id = "page_jobs", tag = "page", security(()),
+    responses((status = 200, description = "HTML", body = String, content_type = "text/html")))]
+async fn index() -> Response {
+    html(INDEX_HTML)
+}
+
+/// The live page of one job (the page itself reads the job through the API).
+#[utoipa::path(get, path = "/jobs/{id}", operation_id = "page_job", tag = "page", security(()),
+    params(("id" = String, Path, description = "The job id")),
+    responses((status = 200, description = "HTML", body = String, content_type = "text/html")))]
+async fn job_page(Path(_id): Path<String>) -> Response {
+    html(JOB_HTML)
 }
 
 /// Whether a path is one of the page's (served without the token).
@@ -53,6 +64,13 @@ fn html(body: &'static str) -> Response {
     ([(header::CONTENT_TYPE, "text/html; charset=utf-8"), (header::CACHE_CONTROL, "no-cache")], body).into_response()
 }
 
+/// The page's scripts and stylesheet.
+#[utoipa::path(get, path = "/ui/{file}", operation_id = "page_file", tag = "page", security(()),
+    params(("file" = String, Path, description = "style.css, common.js, index.js, job.js, draw.js")),
+    responses(
+        (status = 200, description = "The file", content((String = "text/css"), (String = "text/javascript"))),
+        (status = 404, description = "No such file", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    ))]
 async fn asset(Path(file): Path<String>) -> Response {
     match ASSETS.iter().find(|(name, _, _)| *name == file) {
         Some((_, kind, body)) => {
@@ -65,6 +83,8 @@ async fn asset(Path(file): Path<String>) -> Response {
 }
 
 /// `{"cases": [{"file", "text"}…]}`: the shipped cases as their files read.
+#[utoipa::path(get, path = "/ui/cases.json", operation_id = "page_cases", tag = "page", security(()),
+    responses((status = 200, description = "The shipped cases", body = Object)))]
 async fn cases() -> Response {
     let list: Vec<serde_json::Value> =
         CASES.iter().map(|(file, text)| serde_json::json!({ "file": file, "text": text })).collect();
