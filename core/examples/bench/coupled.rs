@@ -235,6 +235,14 @@ pub fn gas_team() {
         v[v.len() / 2]
     };
     let [a, b, c] = times.each_mut().map(median);
+    // The three were stepped alike: equal digests mean the same bits on every path.
+    let digest = |g: &fluidbed_core::cfd::GasSolver| {
+        let n = g.grid().num_cells();
+        let bits: String =
+            (0..n).map(|c| format!("{:x}{:x}", g.density(c).to_bits(), g.velocity_xyz(c)[2].to_bits())).collect();
+        format!("{:016x}", fluidbed_core::dem::fnv1a(&bits))
+    };
+    eprintln!("gas_team state digests: team {}, loops {}, one thread {}", digest(&team), digest(&loops), digest(&one));
     println!(
         "{}",
         json!({"bench": "gas_team", "cells": sim.grid().num_cells(), "team_ms": a, "loops_ms": b, "one_thread_ms": c})
