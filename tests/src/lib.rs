@@ -67,6 +67,26 @@ pub fn poured_case(settled_height_m: f64, end_time_s: f64, snapshot_interval_s: 
     })
 }
 
+/// A small coupled case that bubbles within milliseconds: 1,600 poured particles in a 16-mm
+/// column fluidized at 0.9 m/s (soft particles, E = 10 MPa, DEM step 4 µs), square-grid voidage,
+/// voidage and pressure stored. Tests change what they need on the returned value.
+pub fn small_bubbling_case(name: &str, end_time_s: f64, snapshot_interval_s: f64) -> Value {
+    json!({
+        "name": name,
+        "column": { "diameter_m": 0.016, "height_m": 0.048 },
+        "particles": { "diameter_m": D, "density_kg_m3": 1000.0, "youngs_modulus_pa": 1.0e7,
+            "poisson_ratio": 0.33, "sliding_friction": 0.1,
+            "normal_damping": { "tsuji_alpha": 0.02 }, "tangential_damping": { "tsuji_alpha": 0.0001 } },
+        "bed": { "generated": { "count": 1600, "seed": 4 } },
+        "dem": { "time_step_s": 4.0e-6 },
+        "gas": { "superficial_velocity_m_s": 0.9, "ramp_time_s": 0.001 },
+        "grid": { "dr_m": 0.004, "n0": 3 },
+        "voidage": { "method": "square_grid", "split": "cuboid" },
+        "end_time_s": end_time_s,
+        "outputs": { "snapshot_interval_s": snapshot_interval_s, "fields": ["voidage", "pressure"] }
+    })
+}
+
 /// Poll a job until `pred` holds for it (or `timeout` passes); the last job document.
 pub async fn wait_until(
     http: &reqwest::Client,

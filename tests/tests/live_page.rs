@@ -13,22 +13,9 @@ use std::time::Duration;
 
 const WAIT: Duration = Duration::from_secs(300);
 
-/// A bubbling bed of 1600 poured particles: fifteen snapshots over a few seconds of wall time.
+/// The shared small bubbling bed (`fluidbed_tests::small_bubbling_case`).
 fn bubbling_case() -> Value {
-    json!({
-        "name": "live page bed",
-        "column": { "diameter_m": 0.016, "height_m": 0.048 },
-        "particles": { "diameter_m": D, "density_kg_m3": 1000.0, "youngs_modulus_pa": 1.0e7,
-            "poisson_ratio": 0.33, "sliding_friction": 0.1,
-            "normal_damping": { "tsuji_alpha": 0.02 }, "tangential_damping": { "tsuji_alpha": 0.0001 } },
-        "bed": { "generated": { "count": 1600, "seed": 4 } },
-        "dem": { "time_step_s": 4.0e-6 },
-        "gas": { "superficial_velocity_m_s": 0.9, "ramp_time_s": 0.001 },
-        "grid": { "dr_m": 0.004, "n0": 3 },
-        "voidage": { "method": "square_grid", "split": "cuboid" },
-        "end_time_s": 0.012,
-        "outputs": { "snapshot_interval_s": 0.0008, "fields": ["voidage", "pressure"] }
-    })
+    small_bubbling_case("live page bed", 0.012, 0.0008)
 }
 
 /// Console or network entries at error level.

@@ -3,7 +3,7 @@
 //! snapshot bytes written (the files' sizes on disk), and requests by route template and status.
 
 use fluidbed_tests::*;
-use serde_json::{json, Value};
+use serde_json::Value;
 use std::time::Duration;
 
 const WAIT: Duration = Duration::from_secs(300);
@@ -27,18 +27,7 @@ async fn metrics_report_jobs_running_rates_bytes_and_requests() {
     let dir = TempDir::new("metrics");
     let server = start(dir.path(), None);
     let base = server.url();
-    let case = json!({
-        "name": "metrics bed",
-        "column": { "diameter_m": 0.016, "height_m": 0.048 },
-        "particles": { "diameter_m": D, "density_kg_m3": 1000.0, "youngs_modulus_pa": 1.0e7 },
-        "bed": { "generated": { "count": 1600, "seed": 4 } },
-        "dem": { "time_step_s": 4.0e-6 },
-        "gas": { "superficial_velocity_m_s": 0.9, "ramp_time_s": 0.001 },
-        "grid": { "dr_m": 0.004, "n0": 3 },
-        "voidage": { "method": "square_grid", "split": "cuboid" },
-        "end_time_s": 0.012,
-        "outputs": { "snapshot_interval_s": 0.0008, "fields": ["voidage", "pressure"] }
-    });
+    let case = small_bubbling_case("metrics bed", 0.012, 0.0008);
     let r = http.post(format!("{base}/v1/jobs")).json(&case).send().await.unwrap();
     assert_eq!(r.status(), 201);
     let id = r.json::<Value>().await.unwrap()["id"].as_str().unwrap().to_string();

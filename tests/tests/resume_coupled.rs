@@ -11,23 +11,12 @@ use std::time::Duration;
 
 const WAIT: Duration = Duration::from_secs(600);
 
-/// 1600 particles bubbling at 0.9 m/s in a 16-mm column: seven snapshots in 1002 DEM steps.
+/// The shared small bubbling bed, coupled every 3 DEM steps, the particles stored too.
 fn bubbling_case() -> Value {
-    json!({
-        "name": "e2e coupled resume",
-        "column": { "diameter_m": 0.016, "height_m": 0.048 },
-        "particles": { "diameter_m": D, "density_kg_m3": 1000.0, "youngs_modulus_pa": 1.0e7,
-            "poisson_ratio": 0.33, "sliding_friction": 0.1,
-            "normal_damping": { "tsuji_alpha": 0.02 }, "tangential_damping": { "tsuji_alpha": 0.0001 } },
-        "bed": { "generated": { "count": 1600, "seed": 4 } },
-        "dem": { "time_step_s": 4.0e-6 },
-        "gas": { "superficial_velocity_m_s": 0.9, "ramp_time_s": 0.001 },
-        "grid": { "dr_m": 0.004, "n0": 3 },
-        "voidage": { "method": "square_grid", "split": "cuboid" },
-        "coupling": { "interval_steps": 3 },
-        "end_time_s": 0.004008,
-        "outputs": { "snapshot_interval_s": 0.000668, "fields": ["voidage", "pressure", "particles"] }
-    })
+    let mut c = small_bubbling_case("e2e coupled resume", 0.004008, 0.000668);
+    c["coupling"] = json!({ "interval_steps": 3 });
+    c["outputs"]["fields"] = json!(["voidage", "pressure", "particles"]);
+    c
 }
 
 fn start_two_threads(dir: &Path) -> Server {
