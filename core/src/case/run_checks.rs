@@ -70,9 +70,19 @@ impl Case {
         Some(0.5 * (lo + hi))
     }
 
+    /// Peak Hertz overlap over d of a head-on impact of two particles at speed v (PHYSICS.md 2.4:
+    /// δ_max = (15 m* v² / (16 √R* E*))^(2/5)).
+    pub fn impact_overlap_fraction(&self, v: f64) -> f64 {
+        let p = &self.particles;
+        let (m_star, r_star) = (self.particle_mass_kg() / 2.0, p.diameter_m / 4.0);
+        let e_star = p.youngs_modulus_pa / (2.0 * (1.0 - p.poisson_ratio * p.poisson_ratio));
+        (15.0 * m_star * v * v / (16.0 * r_star.sqrt() * e_star)).powf(0.4) / p.diameter_m
+    }
+
     /// The run checks of the module comment, added to `r`.
     pub(super) fn validate_run(&self, r: &mut ValidationReport) {
         self.check_contact_time(r);
+        self.check_impact_overlap(r);
         self.check_step_count(r);
         if let Some(g) = &self.gas {
             let u = g.superficial_velocity_m_s;
@@ -131,6 +141,30 @@ impl Case {
                 json_num(dt),
                 format!("<= t_c/20 = {:.3e} s recommended (t_c at {v:.2} m/s)", tc / 20.0),
                 "DEM step above t_c/20: contacts resolved by fewer than 20 steps",
+            );
+        }
+    }
+
+    /// A warning when an impact at the largest expected speed would overlap beyond the watchdog's
+    /// bound: the run will likely be stopped; the E that keeps it within the bound.
+    fn check_impact_overlap(&self, r: &mut ValidationReport) {
+        let v = self.largest_impact_speed_m_s();
+        let f = self.impact_overlap_fraction(v);
+        if f.is_finite() && f > MAX_OVERLAP_FRACTION {
+            // δ ∝ E^(-2/5): E must grow by (f / f_max)^(5/2).
+            let e = self.particles.youngs_modulus_pa * (f / MAX_OVERLAP_FRACTION).powf(2.5);
+            r.warn(
+                "/particles/youngs_modulus_pa",
+                json_num(self.particles.youngs_modulus_pa),
+                format!(
+                    ">= {e:.3e} Pa to keep an impact at {v:.2} m/s within {:.0}% of d",
+                    MAX_OVERLAP_FRACTION * 100.0
+                ),
+                format!(
+                    "an impact at {v:.2} m/s overlaps {:.0}% of d (Hertz): the watchdog stops runs beyond {:.0}%",
+                    f * 100.0,
+                    MAX_OVERLAP_FRACTION * 100.0
+                ),
             );
         }
     }

@@ -98,3 +98,20 @@ fn a_run_of_more_than_1e12_steps_is_refused() {
     c.end_time_s = 100.0;
     assert!(!paths(&c.validate().errors).contains(&"/end_time_s"));
 }
+
+#[test]
+fn soft_particles_at_the_largest_impact_speed_warn_of_a_deep_overlap() {
+    // d = 1.2 mm, ρ = 1000, E = 1.2e8 Pa: 0.88% of d at 1 m/s (1.2% at √(2gH) = 1.53 m/s); E = 1e5 Pa: 21%.
+    let mut c = gas_case();
+    let f = c.impact_overlap_fraction(1.0);
+    assert!(f > 0.0087 && f < 0.0089, "{f}");
+    assert!(!c.validate().warnings.iter().any(|w| w.path == "/particles/youngs_modulus_pa"));
+    c.particles.youngs_modulus_pa = 1e5;
+    let rep = c.validate();
+    let w = rep.warnings.iter().find(|w| w.path == "/particles/youngs_modulus_pa").expect("warned");
+    assert!(w.message.contains("watchdog"), "{}", w.message);
+    // the E it asks for keeps the overlap at 10%
+    let e: f64 = w.allowed.split_whitespace().nth(1).unwrap().parse().unwrap();
+    c.particles.youngs_modulus_pa = e;
+    assert!((c.impact_overlap_fraction(c.largest_impact_speed_m_s()) - 0.1).abs() < 1e-3);
+}

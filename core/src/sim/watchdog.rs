@@ -56,18 +56,14 @@ impl Limits {
     }
 }
 
-/// Head-on impact speed of two particles whose Hertz overlap peaks at MAX_OVERLAP_FRACTION·d:
-/// δ_max = (15 m* v² / (16 √R* E*))^(2/5) (PHYSICS.md 2.4) solved for v.
+/// Head-on impact speed of two particles whose Hertz overlap peaks at MAX_OVERLAP_FRACTION·d
+/// (δ_max ∝ v^(4/5): `Case::impact_overlap_fraction` at 1 m/s scaled).
 fn overlap_speed(case: &Case) -> f64 {
-    let p = &case.particles;
-    let (m_star, r_star) = (case.particle_mass_kg() / 2.0, p.diameter_m / 4.0);
-    let e_star = p.youngs_modulus_pa / (2.0 * (1.0 - p.poisson_ratio * p.poisson_ratio));
-    let delta = MAX_OVERLAP_FRACTION * p.diameter_m;
-    (16.0 * r_star.sqrt() * e_star * delta.powf(2.5) / (15.0 * m_star)).sqrt()
+    (MAX_OVERLAP_FRACTION / case.impact_overlap_fraction(1.0)).powf(1.25)
 }
 
 fn when(t: f64, step: u64) -> String {
-    format!("t = {t:.6} s (DEM step {step})")
+    format!("t = {t:.6e} s (DEM step {step})")
 }
 
 fn at(x: [f64; 3]) -> String {
@@ -128,7 +124,7 @@ pub fn check_dem(dem: &DemSystem, lim: &Limits, steps: u64, t: f64) -> Result<()
         let id = dem.ids().get(k).copied().unwrap_or(0);
         let x = dem.positions().get(k).copied().unwrap_or([f64::NAN; 3]);
         return Err(SimError::Unstable(format!(
-            "particle overlap {:.1}% of d exceeds {:.0}% at particle {id} at {} at {}; lower dem.time_step_s or raise particles.youngs_modulus_pa",
+            "particle overlap {:.2}% of d exceeds {:.0}% at particle {id} at {} at {}; lower dem.time_step_s or raise particles.youngs_modulus_pa",
             ov * 100.0,
             MAX_OVERLAP_FRACTION * 100.0,
             at(x),

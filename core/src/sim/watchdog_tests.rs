@@ -46,7 +46,7 @@ fn a_particle_beyond_the_speed_bound_is_named_with_its_place_and_step() {
         "particle 1 at (1.0000e-2, 0.0000e0, 5.0000e-2) m",
         "moves at 3.000e0 m/s",
         "DEM step 200",
-        "t = 0.000250 s",
+        "t = 2.500000e-4 s",
         "dem.time_step_s",
     ] {
         assert!(m.contains(want), "{want:?} not in {m}");
