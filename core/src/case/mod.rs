@@ -4,10 +4,12 @@
 
 pub mod bounds;
 mod contact_law;
+mod run_checks;
 pub mod strict_json;
 mod validate;
 
 pub use contact_law::ContactLawChoice;
+pub use run_checks::{MAX_DEM_STEPS, MAX_INLET_MACH, WARN_INITIAL_OVERLAP_FRACTION};
 pub use validate::{Problem, Severity, ValidationReport};
 
 use schemars::JsonSchema;
@@ -425,7 +427,7 @@ impl Case {
     }
 }
 
-/// Impact speed used to check the DEM step against the contact time.
+/// Least impact speed the DEM step is checked at (`largest_impact_speed_m_s` takes the case's own).
 pub const CHECK_IMPACT_SPEED_M_S: f64 = 1.0;
 
 fn d_gravity() -> f64 {
@@ -486,5 +488,7 @@ fn d_one() -> f64 {
     1.0
 }
 
+#[cfg(test)]
+mod run_checks_tests;
 #[cfg(test)]
 mod tests;

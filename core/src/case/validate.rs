@@ -56,10 +56,22 @@ impl ValidationReport {
             Severity::Warning => self.warnings.push(p),
         }
     }
-    fn error(&mut self, path: &str, value: impl Into<Value>, allowed: impl Into<String>, message: impl Into<String>) {
+    pub(super) fn error(
+        &mut self,
+        path: &str,
+        value: impl Into<Value>,
+        allowed: impl Into<String>,
+        message: impl Into<String>,
+    ) {
         self.push(Severity::Error, path, value.into(), allowed, message)
     }
-    fn warn(&mut self, path: &str, value: impl Into<Value>, allowed: impl Into<String>, message: impl Into<String>) {
+    pub(super) fn warn(
+        &mut self,
+        path: &str,
+        value: impl Into<Value>,
+        allowed: impl Into<String>,
+        message: impl Into<String>,
+    ) {
         self.push(Severity::Warning, path, value.into(), allowed, message)
     }
     /// Error unless lo <= x <= hi (with open ends when the flags say so); NaN is always an error.
@@ -215,6 +227,7 @@ impl Case {
         if !(1..=1000).contains(&n) {
             r.error("/coupling/interval_steps", n, "[1, 1000]", "DEM steps between couplings out of range");
         }
+        self.validate_run(&mut r);
         r.errors.extend(super::bounds::check(self));
         r
     }
@@ -299,24 +312,6 @@ impl Case {
         r.range("/dem/skin_fraction", self.dem.skin_fraction, 0.01, false, 2.0, false, "Verlet skin / d");
         if self.dem.threads > 1024 {
             r.error("/dem/threads", self.dem.threads, "[0, 1024]", "thread count out of range");
-        }
-        let tc = self.hertz_contact_time_s(CHECK_IMPACT_SPEED_M_S);
-        if tc.is_finite() && dt > 0.0 {
-            if dt > tc / 10.0 {
-                r.error(
-                    "/dem/time_step_s",
-                    json_num(dt),
-                    format!("<= t_c/10 = {:.3e} s (t_c = {:.3e} s at 1 m/s)", tc / 10.0, tc),
-                    "DEM step too large for the Hertz contact time",
-                );
-            } else if dt > tc / 20.0 {
-                r.warn(
-                    "/dem/time_step_s",
-                    json_num(dt),
-                    format!("<= t_c/20 = {:.3e} s recommended", tc / 20.0),
-                    "DEM step above t_c/20: contacts resolved by fewer than 20 steps",
-                );
-            }
         }
     }
 

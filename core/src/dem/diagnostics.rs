@@ -77,4 +77,31 @@ impl DemSystem {
     pub fn max_coulomb_excess(&self) -> f64 {
         self.last.1
     }
+
+    /// The particle (index in the current order) with the deepest overlap now, pairs and walls,
+    /// and that overlap over d: the watchdog's "where" when an overlap stops a run (O(pairs)).
+    pub fn deepest_overlap(&self) -> Option<(usize, f64)> {
+        let (r, x) = (self.p.radius, &self.x);
+        let nl = &self.near.list;
+        let mut worst: Option<(usize, f64)> = None;
+        let mut keep = |k: usize, depth: f64| {
+            if depth > 0.0 && worst.is_none_or(|w| depth > w.1) {
+                worst = Some((k, depth));
+            }
+        };
+        for i in 0..x.len() {
+            for k in nl.offsets.get(i).map_or(0, |&o| o as usize)..nl.offsets.get(i + 1).map_or(0, |&o| o as usize) {
+                let j = nl.nbr[k] as usize;
+                let d = ((0..3).map(|a| (x[j][a] - x[i][a]).powi(2)).sum::<f64>()).sqrt();
+                keep(i, 2.0 * r - d);
+            }
+            let rho = (x[i][0].powi(2) + x[i][1].powi(2)).sqrt();
+            keep(i, r - x[i][2]);
+            keep(i, rho + r - self.p.tube_radius);
+            if self.p.lid {
+                keep(i, x[i][2] + r - self.p.height);
+            }
+        }
+        worst.map(|(k, depth)| (k, depth / (2.0 * r)))
+    }
 }

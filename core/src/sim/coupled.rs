@@ -117,7 +117,7 @@ impl Simulation {
             while gas.steps() < target {
                 gas.step(dt_g);
                 if gas.steps().is_multiple_of(watchdog::GAS_CHECK_EVERY) {
-                    watchdog::check_gas(gas, dt_g, t)?;
+                    watchdog::check_gas(gas, &self.limits, dt_g, t, self.st.steps)?;
                 }
             }
             self.timers.gas += t0.elapsed().as_secs_f64();
@@ -130,7 +130,7 @@ impl Simulation {
         self.timers.contacts_integration += t0.elapsed().as_secs_f64() - neighbours;
         self.st.steps += 1;
         if particles_move {
-            watchdog::check_dem(&self.st.dem, self.st.steps, self.time())?;
+            watchdog::check_dem(&self.st.dem, &self.limits, self.st.steps, self.time())?;
         }
         Ok(())
     }

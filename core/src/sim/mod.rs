@@ -9,6 +9,7 @@ mod watchdog;
 
 pub use plan::Plan;
 pub use snapshot::{GridInfo, ParticleSnapshot, Snapshot, SnapshotSink};
+pub use watchdog::MAX_OVERLAP_FRACTION;
 
 use crate::case::{Case, Field};
 use crate::cfd::GasSolver;
@@ -89,6 +90,7 @@ pub struct Simulation {
     buf: coupled::Buffers,
     steps_per_snapshot: u64,
     end_steps: u64,
+    limits: watchdog::Limits,
 }
 
 impl Simulation {
@@ -114,7 +116,8 @@ impl Simulation {
         let steps_per_snapshot = ((st.case.outputs.snapshot_interval_s / dt).round() as u64).max(1);
         let end_steps = ((st.case.end_time_s / dt).round() as u64).max(1);
         let buf = coupled::Buffers::new(&grid, st.dem.len());
-        Simulation { st, timers: StageTimers::default(), grid, voidage, buf, steps_per_snapshot, end_steps }
+        let limits = watchdog::Limits::of(&st.case);
+        Simulation { st, timers: StageTimers::default(), grid, voidage, buf, steps_per_snapshot, end_steps, limits }
     }
 
     pub fn case(&self) -> &Case {
@@ -177,7 +180,7 @@ impl Simulation {
     /// Snapshot 0 is the initial state, returned by the first call before any step.
     pub fn advance(&mut self, max_steps: u64) -> Result<Option<Snapshot>, SimError> {
         if self.st.snapshots_taken == 0 {
-            return Ok(Some(self.take_snapshot()));
+            return self.take_snapshot().map(Some);
         }
         for _ in 0..max_steps {
             if self.st.steps >= self.end_steps {
@@ -188,7 +191,7 @@ impl Simulation {
                 let t0 = std::time::Instant::now();
                 let s = self.take_snapshot();
                 self.timers.output += t0.elapsed().as_secs_f64();
-                return Ok(Some(s));
+                return s.map(Some);
             }
         }
         Ok(None)
@@ -222,7 +225,9 @@ impl Simulation {
         Ok(sim)
     }
 
-    fn take_snapshot(&mut self) -> Snapshot {
+    /// The snapshot of now; a field holding NaN or ∞ stops the run instead (no stored snapshot
+    /// ever holds one: the last good snapshot and checkpoint stay the run's last).
+    fn take_snapshot(&mut self) -> Result<Snapshot, SimError> {
         if self.st.plan.voidage_field && !self.st.plan.coupling {
             self.refresh_voidage_field();
         }
@@ -255,8 +260,14 @@ impl Simulation {
             layer_pressure_drop_pa: layer_dp,
             particles,
         };
+        if let Some(bad) = s.first_non_finite() {
+            return Err(SimError::Unstable(format!(
+                "snapshot {} at t = {:.6} s (DEM step {}) would hold {bad}; lower dem.time_step_s or gas.time_step_s",
+                s.index, s.time_s, s.step
+            )));
+        }
         self.st.snapshots_taken += 1;
-        s
+        Ok(s)
     }
 
     /// Particle state in the original order.

@@ -66,6 +66,30 @@ pub struct Snapshot {
     pub particles: Option<ParticleSnapshot>,
 }
 
+impl Snapshot {
+    /// The first NaN or ∞ in any field, named with its field and cell or particle (None when all
+    /// values are finite). O(cells + particles); the simulation checks every snapshot it makes.
+    pub fn first_non_finite(&self) -> Option<String> {
+        fn scalars(name: &str, what: &str, v: Option<&[f64]>) -> Option<String> {
+            let (k, x) = v?.iter().enumerate().find(|(_, x)| !x.is_finite())?;
+            Some(format!("{name} = {x} at {what} {k}"))
+        }
+        fn vectors(name: &str, what: &str, v: Option<&[[f64; 3]]>) -> Option<String> {
+            let (k, x) = v?.iter().enumerate().find(|(_, x)| !x.iter().all(|c| c.is_finite()))?;
+            Some(format!("{name} = {x:?} at {what} {k}"))
+        }
+        let p = self.particles.as_ref();
+        scalars("voidage", "cell", self.voidage.as_deref())
+            .or_else(|| scalars("pressure", "cell", self.pressure_pa.as_deref()))
+            .or_else(|| vectors("gas velocity", "cell", self.gas_velocity_m_s.as_deref()))
+            .or_else(|| scalars("pressure drop", "snapshot", self.pressure_drop_pa.as_ref().map(std::slice::from_ref)))
+            .or_else(|| scalars("layer pressure drop", "layer boundary", self.layer_pressure_drop_pa.as_deref()))
+            .or_else(|| vectors("position", "particle", p.map(|p| &p.positions_m[..])))
+            .or_else(|| vectors("velocity", "particle", p.map(|p| &p.velocities_m_s[..])))
+            .or_else(|| (!self.time_s.is_finite()).then(|| format!("time = {}", self.time_s)))
+    }
+}
+
 /// Receives snapshots as a run produces them.
 pub trait SnapshotSink {
     fn snapshot(&mut self, s: &Snapshot);

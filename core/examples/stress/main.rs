@@ -1,0 +1,33 @@
+//! Stress cases of the solver (issue 22): `cargo run --release -p fluidbed-core --example stress -- NAME`.
+//! `extremes [CASES] [SEED]`: seeded random cases inside and beyond the schema's ranges; prints a
+//! line per case, the outcome table, one stop message per kind, and last one JSON line.
+
+mod extremes;
+
+use std::time::Duration;
+
+/// Wall-time bound of one case: beyond it the case counts as a hang.
+const CASE_LIMIT: Duration = Duration::from_secs(20);
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    match args.first().map(String::as_str) {
+        Some("extremes") => {
+            let n = args.get(1).and_then(|s| s.parse().ok()).unwrap_or(300);
+            let seed = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(22_000);
+            let sum = extremes::run_all(n, seed, CASE_LIMIT, true);
+            println!("\n{}", sum.table());
+            for (seed, m) in &sum.stop_examples {
+                println!("- case {seed}: \"{m}\"");
+            }
+            println!("{}", sum.json());
+            if sum.panics + sum.hangs + sum.nan_snapshots + sum.unexplained > 0 {
+                std::process::exit(1);
+            }
+        }
+        other => {
+            eprintln!("usage: stress extremes [CASES] [SEED] (got {other:?})");
+            std::process::exit(2);
+        }
+    }
+}
