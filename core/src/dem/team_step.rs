@@ -20,27 +20,13 @@ use super::work_split::Sums;
 use super::DemParams;
 #[cfg(test)]
 use crate::team::has_own_team;
-use crate::team::Raw;
+use crate::team::{spin_until, Raw};
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Spins (then yields) until every chunk c with `need(c)` is done; false if a chunk failed
 /// (its thread panicked), so that nobody waits for it for ever.
 fn wait_for_chunks(done: &[AtomicBool], failed: &AtomicBool, need: impl Fn(usize) -> bool) -> bool {
-    for c in (0..done.len()).filter(|&c| need(c)) {
-        let mut spins = 0u32;
-        while !done[c].load(Ordering::Acquire) {
-            if failed.load(Ordering::Acquire) {
-                return false;
-            }
-            if spins < 1 << 12 {
-                std::hint::spin_loop();
-                spins += 1;
-            } else {
-                std::thread::yield_now();
-            }
-        }
-    }
-    true
+    (0..done.len()).filter(|&c| need(c)).all(|c| spin_until(|| done[c].load(Ordering::Acquire), failed))
 }
 
 /// Tests only: chunk c panics while this holds c + 1, on pools without their own team lock (the

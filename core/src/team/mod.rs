@@ -15,4 +15,4 @@ pub(crate) use lock::has_own_team;
 pub use lock::solver_pool;
 pub(crate) use lock::TeamLock;
 pub(crate) use shared_slice::Raw;
-pub(crate) use spin_barrier::SpinBarrier;
+pub(crate) use spin_barrier::{spin_until, SpinBarrier};

@@ -4,6 +4,24 @@
 
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
+/// Spins (then yields) until `done()`; false as soon as `failed` is set (a thread of the team
+/// panicked), so that nobody waits for it for ever.
+pub(crate) fn spin_until(done: impl Fn() -> bool, failed: &AtomicBool) -> bool {
+    let mut spins = 0u32;
+    while !done() {
+        if failed.load(Ordering::Acquire) {
+            return false;
+        }
+        if spins < 1 << 12 {
+            std::hint::spin_loop();
+            spins += 1;
+        } else {
+            std::thread::yield_now();
+        }
+    }
+    true
+}
+
 pub(crate) struct SpinBarrier {
     threads: usize,
     arrived: AtomicUsize,
@@ -31,19 +49,8 @@ impl SpinBarrier {
             self.generation.fetch_add(1, Ordering::Release);
             return !self.failed.load(Ordering::Acquire);
         }
-        let mut spins = 0u32;
-        while self.generation.load(Ordering::Acquire) == generation {
-            if self.failed.load(Ordering::Acquire) {
-                return false;
-            }
-            if spins < 1 << 12 {
-                std::hint::spin_loop();
-                spins += 1;
-            } else {
-                std::thread::yield_now();
-            }
-        }
-        !self.failed.load(Ordering::Acquire)
+        spin_until(|| self.generation.load(Ordering::Acquire) != generation, &self.failed)
+            && !self.failed.load(Ordering::Acquire)
     }
 
     /// Marks the team failed: every `wait`, now and later, returns false.
