@@ -7,7 +7,8 @@
 //!    beside the noise floor: the same reference from a second poured bed (seed 2). An error below
 //!    the floor is inside the noise.
 //!    The costs are measured again interleaved in one process (`tradeoff_cost` lines), the figures
-//!    to compare. `-- tradeoff errors|cost|voidage` runs one part (the voidage part always runs).
+//!    to compare. `-- tradeoff errors|cost|voidage` runs one part (the voidage part always runs); `layer`
+//!    the reference and the fluid layer height point alone.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -167,18 +168,31 @@ fn coupled_front() -> f64 {
         json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
         "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)})
     );
-    // Fluid layer height dr instead of dr/2: its layers against the reference's merged in pairs.
-    let coarse = layers_of_dr(&reference);
+    layer_height_point(&reference, r);
+    default_cost
+}
+
+/// Fluid layer height dr instead of dr/2 at the default interval, against the reference's
+/// statistics `r` with its layers merged in pairs.
+fn layer_height_point(reference: &Case, r: Stats) {
+    let coarse = layers_of_dr(reference);
     let (snaps, cost) = window(&coarse, "tradeoff-dz-dr", coarse.coupling.interval_steps);
     let s = stats(&snaps, &fluid_grid(&coarse));
     let pairs = |v: &[f64]| v.chunks(2).map(|p| p.iter().sum::<f64>() / p.len() as f64).collect::<Vec<_>>();
-    let r2 = Stats { axial: pairs(&r.axial), radial: r.radial.clone(), ..r };
+    let r2 = Stats { axial: pairs(&r.axial), ..r };
     println!(
         "{}",
         json!({"bench": "tradeoff_point", "knob": "layer_height", "setting": "dz = dr at the default interval",
         "wall_s_per_sim_s": cost, "errors": errors(&s, &r2), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
     );
-    default_cost
+}
+
+/// `-- tradeoff layer`: the reference window and the layer-height point alone.
+fn layer_front() {
+    let reference = bed(1);
+    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
+    let r = stats(&ref_snaps, &fluid_grid(&reference));
+    layer_height_point(&reference, r);
 }
 
 /// Mean L1 over three packings and ns per particle per call of `make`'s method.
@@ -243,6 +257,9 @@ pub fn run() {
     let part = std::env::args().nth(2).unwrap_or_default();
     if part.is_empty() || part == "errors" {
         coupled_front();
+    }
+    if part == "layer" {
+        layer_front();
     }
     if part.is_empty() || part == "cost" {
         interleaved_costs();
