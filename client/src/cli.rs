@@ -2,7 +2,7 @@
 
 use crate::api::Api;
 use crate::exit;
-use crate::fetch::{fetch, Formats};
+use crate::fetch::{fetch, fetch_analysis, Formats};
 use crate::outcome::{api_fail, fail, outcome_code, report_outcome};
 use crate::validate::validate;
 use crate::watch::watch;
@@ -56,6 +56,14 @@ enum Verb {
         /// Per-snapshot encodings: npy, vtk, json (comma separated).
         #[arg(long, default_value = "npy,vtk")]
         formats: String,
+    },
+    /// Download the job's analysis (analysis.json and its figures) and print its main figures;
+    /// the case's `analysis` section sets the window and the heights.
+    Analyze {
+        id: String,
+        /// Output folder (default ./fluidbed-out/<job id>/).
+        #[arg(long)]
+        out: Option<PathBuf>,
     },
     /// Cancel a job.
     Cancel { id: String },
@@ -112,6 +120,32 @@ fn print_job(j: &Job, json_out: bool) {
     }
 }
 
+/// The headline figures of an analysis document.
+fn print_analysis(a: &serde_json::Value) {
+    let num = |v: &serde_json::Value| v.as_f64().map(|x| format!("{x:.4}")).unwrap_or_else(|| "—".into());
+    println!("window {} – {} s, {} samples", num(&a["from_s"]), num(&a["to_s"]), a["samples"]);
+    let dp = &a["pressure_drop"];
+    println!(
+        "ΔP mean {} Pa, std {} Pa, dominant frequency {} Hz",
+        num(&dp["mean_pa"]),
+        num(&dp["std_pa"]),
+        num(&dp["dominant_frequency_hz"])
+    );
+    println!("bed height {} m", num(&a["bed_height_m"]));
+    println!(
+        "bubbles {} per second at {} m",
+        num(&a["bubbles"]["count"]["per_second"]),
+        num(&a["bubbles"]["height_m"])
+    );
+    let rise = &a["rise_velocity"];
+    println!(
+        "rise velocity {} m/s between {} and {} m",
+        num(&rise["voidage"]["velocity_m_s"]),
+        num(&rise["lower_m"]),
+        num(&rise["upper_m"])
+    );
+}
+
 async fn dispatch(cli: Cli) -> i32 {
     let token = cli.token.clone().filter(|t| !t.is_empty());
     let server = cli.server.clone().unwrap_or_else(|| "http://127.0.0.1:8471".into());
@@ -121,7 +155,12 @@ async fn dispatch(cli: Cli) -> i32 {
     };
     let j = cli.json;
     // A job id is 16 hex digits: anything else (`../../x`) would leave the output folder or the URL.
-    if let Verb::Status { id } | Verb::Watch { id } | Verb::Fetch { id, .. } | Verb::Cancel { id } = &cli.verb {
+    if let Verb::Status { id }
+    | Verb::Watch { id }
+    | Verb::Fetch { id, .. }
+    | Verb::Analyze { id, .. }
+    | Verb::Cancel { id } = &cli.verb
+    {
         if id.is_empty() || id.len() > 64 || !id.bytes().all(|b| b.is_ascii_alphanumeric() || b == b'-') {
             return fail(exit::USAGE, &format!("`{id}` is not a job id (letters, digits and '-')"));
         }
@@ -190,6 +229,26 @@ async fn dispatch(cli: Cli) -> i32 {
                     if j {
                         println!("{}", json!({ "id": id, "files": files }));
                     } else {
+                        println!("{} files in {}", files.len(), out.display());
+                    }
+                    exit::OK
+                }
+                Err(e) => api_fail(e, j),
+            }
+        }
+        Verb::Analyze { id, out } => {
+            let out = out.unwrap_or_else(|| PathBuf::from("fluidbed-out").join(&id));
+            match fetch_analysis(&api, &id, &out).await {
+                Ok(files) if files.is_empty() => {
+                    fail(exit::SERVER, &format!("job {id} has no analysis yet (no checkpoint written)"))
+                }
+                Ok(files) => {
+                    let text = std::fs::read_to_string(out.join("analysis.json")).unwrap_or_default();
+                    let a: serde_json::Value = serde_json::from_str(&text).unwrap_or_default();
+                    if j {
+                        println!("{}", json!({ "id": id, "files": files, "analysis": a }));
+                    } else {
+                        print_analysis(&a);
                         println!("{} files in {}", files.len(), out.display());
                     }
                     exit::OK

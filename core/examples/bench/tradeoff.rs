@@ -8,7 +8,9 @@
 //!    the floor is inside the noise.
 //!    The costs are measured again interleaved in one process (`tradeoff_cost` lines), the figures
 //!    to compare. `-- tradeoff errors|cost|voidage` runs one part (the voidage part always runs); `layer`
-//!    the reference and the fluid layer height point alone.
+//!    the reference and the fluid layer height point alone, `sound` the reference and the acoustic
+//!    speed points (the gas's pressure waves at f = ½ and ¼ of the sound speed, each from its own
+//!    spin-up) alone.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -51,6 +53,16 @@ fn layers_of_dr(c: &Case) -> Case {
     let mut c = c.clone();
     c.grid.dz_m = Some(c.grid.dr_m);
     assert!(((c.column.height_m / c.grid.dr_m).round() * c.grid.dr_m - c.column.height_m).abs() < 1e-12);
+    c
+}
+
+/// Acoustic speed factors of the trade-off (`gas.acoustic_speed_factor`).
+const ACOUSTIC_FACTORS: [f64; 2] = [0.5, 0.25];
+
+/// The trade-off bed with the gas's pressure waves at `f` times the sound speed.
+fn with_acoustic_factor(c: &Case, f: f64) -> Case {
+    let mut c = c.clone();
+    c.gas.as_mut().expect("the bed has gas").acoustic_speed_factor = f;
     c
 }
 
@@ -168,8 +180,38 @@ fn coupled_front() -> f64 {
         json!({"bench": "tradeoff_point", "knob": "voidage", "setting": "exact_cylindrical at the default interval",
         "wall_s_per_sim_s": cost, "errors": errors(&stats(&snaps, &grid), &r)})
     );
+    for f in ACOUSTIC_FACTORS {
+        acoustic_point(&reference, &r, f);
+    }
     layer_height_point(&reference, r);
     default_cost
+}
+
+/// The acoustic speed at `f` times the sound speed at the default interval, against the reference.
+fn acoustic_point(reference: &Case, r: &Stats, f: f64) {
+    let case = with_acoustic_factor(reference, f);
+    let (snaps, cost) = window(&case, &format!("tradeoff-acoustic-{f}"), case.coupling.interval_steps);
+    let s = stats(&snaps, &fluid_grid(&case));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "acoustic_speed_factor", "setting": format!("{f} at the default interval"),
+        "wall_s_per_sim_s": cost, "errors": errors(&s, r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+    );
+}
+
+/// `-- tradeoff sound`: the reference window and the acoustic speed points alone.
+fn acoustic_front() {
+    let reference = bed(1);
+    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
+    let r = stats(&ref_snaps, &fluid_grid(&reference));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": 1, "dp_mean_pa": r.dp_mean,
+        "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
+    );
+    for f in ACOUSTIC_FACTORS {
+        acoustic_point(&reference, &r, f);
+    }
 }
 
 /// Fluid layer height dr instead of dr/2 at the default interval, against the reference's
@@ -238,6 +280,11 @@ fn interleaved_costs() {
     let coarse_state = state_at(&layers_of_dr(&reference), SPIN_UP_S, "tradeoff-dz-dr");
     let sim = Simulation::restore(&coarse_state).expect("state");
     runs.push(("dz = dr at the default interval".into(), sim, Tally::default()));
+    for f in ACOUSTIC_FACTORS {
+        let state = state_at(&with_acoustic_factor(&reference, f), SPIN_UP_S, &format!("tradeoff-acoustic-{f}"));
+        let sim = Simulation::restore(&state).expect("state");
+        runs.push((format!("acoustic_speed_factor {f} at the default interval"), sim, Tally::default()));
+    }
     for _ in 0..6 {
         for (_, sim, t) in runs.iter_mut() {
             coupled_round(sim, 1000, t);
@@ -260,6 +307,9 @@ pub fn run() {
     }
     if part == "layer" {
         layer_front();
+    }
+    if part == "sound" {
+        acoustic_front();
     }
     if part.is_empty() || part == "cost" {
         interleaved_costs();

@@ -47,6 +47,10 @@ pub struct Case {
     /// The particle–gas exchange: drag law and how often voidage and drag are recomputed.
     #[serde(default)]
     pub coupling: Coupling,
+    /// Analyses accumulated while the run goes (ΔP statistics, bubbles, rise velocity,
+    /// particle-based time averages); the job's `/analysis`.
+    #[serde(default)]
+    pub analysis: AnalysisSpec,
 }
 
 /// The particle–gas exchange (paper section 2.3).
@@ -250,6 +254,35 @@ impl Default for Outputs {
     }
 }
 
+/// What the run's analysis samples and over which window (sim/run_analysis.rs).
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(default, deny_unknown_fields)]
+pub struct AnalysisSpec {
+    /// Start of the averaging window (simulated s); the start-up before it is not sampled.
+    pub from_s: f64,
+    /// Simulated time between samples (rounded to whole DEM steps).
+    pub sample_interval_s: f64,
+    /// Heights above the distributor of the two cross-sections whose voidage correlation gives
+    /// the bubble rise velocity, lower first (m); absent = 30% and 70% of the time-averaged bed height.
+    pub rise_heights_m: Option<[f64; 2]>,
+    /// Heights of the radial profiles (m); absent = half the time-averaged bed height.
+    pub profile_heights_m: Vec<f64>,
+    /// Cell voidage above which a cell counts as bubble.
+    pub bubble_voidage: f64,
+}
+
+impl Default for AnalysisSpec {
+    fn default() -> Self {
+        AnalysisSpec {
+            from_s: 0.0,
+            sample_interval_s: 0.002,
+            rise_heights_m: None,
+            profile_heights_m: Vec::new(),
+            bubble_voidage: crate::analysis::bubble_fraction::DEFAULT_BUBBLE_VOIDAGE,
+        }
+    }
+}
+
 /// The gas: isothermal, compressible (PHYSICS.md 8), model-A coupling (PHYSICS.md 11).
 #[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
 #[serde(default, deny_unknown_fields)]
@@ -288,6 +321,12 @@ pub struct Gas {
     /// region, PHYSICS.md 7); the stable step is this factor times the limit.
     #[serde(default = "d_cfl")]
     pub cfl_factor: f64,
+    /// Speed of the gas's pressure waves as a fraction f of the isothermal sound speed a = √(R_s T):
+    /// equation of state p = p_out + (f a)²(ρ − ρ_out), a reduced speed of sound for low-Mach flow
+    /// (docs/VALIDATION.md "Acoustic speed"). 1 = the paper's gas; below 1 the stable gas step
+    /// grows as 1/f and the density stays within Δp/(f a)² of ρ_out.
+    #[serde(default = "d_acoustic_speed_factor")]
+    pub acoustic_speed_factor: f64,
 }
 
 impl Default for Gas {
@@ -305,6 +344,7 @@ impl Default for Gas {
             time_step_s: None,
             drag_voidage_min: d_eps_min(),
             cfl_factor: d_cfl(),
+            acoustic_speed_factor: d_acoustic_speed_factor(),
         }
     }
 }
@@ -313,6 +353,10 @@ impl Gas {
     /// Isothermal sound speed a = √(R_s T) (PHYSICS.md 8).
     pub fn sound_speed_m_s(&self) -> f64 {
         (self.specific_gas_constant_j_kg_k * self.temperature_k).sqrt()
+    }
+    /// Speed of the solver's pressure waves, f·a (`acoustic_speed_factor`).
+    pub fn acoustic_speed_m_s(&self) -> f64 {
+        self.acoustic_speed_factor * self.sound_speed_m_s()
     }
     /// Density at the outlet pressure, ρ = p / a².
     pub fn outlet_density_kg_m3(&self) -> f64 {
@@ -477,6 +521,9 @@ fn d_eps_min() -> f64 {
 }
 fn d_cfl() -> f64 {
     0.9
+}
+fn d_acoustic_speed_factor() -> f64 {
+    1.0
 }
 fn d_n0() -> usize {
     3

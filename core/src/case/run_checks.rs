@@ -99,15 +99,21 @@ impl Case {
                     );
                 }
             }
-            let (a, eps) = (g.sound_speed_m_s(), g.inlet_voidage);
+            // The Mach number of the solver's gas: its pressure waves travel at f·a.
+            let (a, eps) = (g.acoustic_speed_m_s(), g.inlet_voidage);
             if a.is_finite() && a > 0.0 && eps > 0.0 && u.is_finite() {
                 let limit = MAX_INLET_MACH * a * eps;
                 if u / eps > MAX_INLET_MACH * a {
+                    let raise = if g.acoustic_speed_factor < 1.0 {
+                        ", or raise /gas/acoustic_speed_factor toward 1"
+                    } else {
+                        ""
+                    };
                     r.error(
                         "/gas/superficial_velocity_m_s",
                         json_num(u),
                         format!(
-                            "<= {limit:.2} m/s (inlet Mach number U/(ε_inlet·a) <= {MAX_INLET_MACH}, a = {a:.1} m/s)"
+                            "<= {limit:.2} m/s (inlet Mach number U/(ε_inlet·f·a) <= {MAX_INLET_MACH}, f·a = {a:.1} m/s{raise})"
                         ),
                         format!("inlet Mach number {:.2} above {MAX_INLET_MACH}", u / eps / a),
                     );

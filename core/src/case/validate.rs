@@ -223,6 +223,7 @@ impl Case {
         if let Some(g) = &self.gas {
             self.validate_gas(g, &mut r);
         }
+        self.validate_analysis(&mut r);
         let n = self.coupling.interval_steps;
         if !(1..=1000).contains(&n) {
             r.error("/coupling/interval_steps", n, "[1, 1000]", "DEM steps between couplings out of range");
@@ -230,6 +231,55 @@ impl Case {
         self.validate_run(&mut r);
         r.errors.extend(super::bounds::check(self));
         r
+    }
+
+    /// The analysis window, its sampling (at most 10⁷ samples: its series grow with them) and heights.
+    fn validate_analysis(&self, r: &mut ValidationReport) {
+        let a = &self.analysis;
+        r.range("/analysis/from_s", a.from_s, 0.0, false, 1e6, false, "analysis window start");
+        let dt = self.dem.time_step_s.max(0.0);
+        r.range(
+            "/analysis/sample_interval_s",
+            a.sample_interval_s,
+            dt,
+            false,
+            1e6,
+            false,
+            "analysis sample interval (at least one DEM step)",
+        );
+        if a.sample_interval_s > 0.0 && self.end_time_s / a.sample_interval_s > 1e7 {
+            r.error(
+                "/analysis/sample_interval_s",
+                json_num(a.sample_interval_s),
+                format!(">= {}", self.end_time_s / 1e7),
+                "more than ten million analysis samples",
+            );
+        }
+        let h = self.column.height_m;
+        if let Some([lo, hi]) = a.rise_heights_m {
+            r.range("/analysis/rise_heights_m/0", lo, 0.0, false, h, false, "lower rise-velocity height");
+            r.range("/analysis/rise_heights_m/1", hi, 0.0, false, h, false, "upper rise-velocity height");
+            if lo >= hi {
+                r.error(
+                    "/analysis/rise_heights_m",
+                    json_num(hi),
+                    format!("> {lo}"),
+                    "the upper height must be above the lower",
+                );
+            }
+        }
+        if a.profile_heights_m.len() > 100 {
+            r.error(
+                "/analysis/profile_heights_m",
+                a.profile_heights_m.len(),
+                "<= 100 heights",
+                "too many profile heights",
+            );
+        }
+        for (i, &z) in a.profile_heights_m.iter().enumerate().take(100) {
+            r.range(&format!("/analysis/profile_heights_m/{i}"), z, 0.0, false, h, false, "profile height");
+        }
+        r.range("/analysis/bubble_voidage", a.bubble_voidage, 0.0, true, 1.0, true, "bubble voidage threshold");
     }
 
     fn validate_bed(&self, r: &mut ValidationReport) {
@@ -343,6 +393,15 @@ impl Case {
         r.range("/gas/outlet_relaxation", g.outlet_relaxation, 0.0, false, 10.0, false, "outlet relaxation σ");
         r.range("/gas/drag_voidage_min", g.drag_voidage_min, 0.01, false, 0.9, false, "drag voidage clamp");
         r.range("/gas/cfl_factor", g.cfl_factor, 0.0, true, 1.0, false, "CFL safety factor");
+        r.range(
+            "/gas/acoustic_speed_factor",
+            g.acoustic_speed_factor,
+            0.01,
+            false,
+            1.0,
+            false,
+            "acoustic speed factor",
+        );
         if let Some(dt) = g.time_step_s {
             // The gas sub-cycles: its step is a whole number of DEM steps, within the acoustic
             // CFL limit inside AB3's stability region (cfd::stability).
@@ -468,4 +527,5 @@ struct PartialCase {
     grid: Option<Grid>,
     voidage: Option<Voidage>,
     coupling: Option<super::Coupling>,
+    analysis: Option<super::AnalysisSpec>,
 }

@@ -68,6 +68,9 @@ pub struct GasSolver {
     parallel: bool,
     /// Parallel right-hand sides as one team of threads (team_rhs.rs) rather than four loops.
     team: bool,
+    /// Reported minus solver pressure: the case's outlet pressure less the solver's c²ρ_out
+    /// (0 at the paper's sound speed; `anchor_pressure`).
+    pressure_offset: f64,
 }
 
 /// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
@@ -78,7 +81,7 @@ impl GasSolver {
     pub fn new(case: &Case, grid: CylGrid) -> GasSolver {
         let g = case.gas.clone().unwrap_or_default();
         let params = GasParams {
-            sound_speed: g.sound_speed_m_s(),
+            sound_speed: g.acoustic_speed_m_s(),
             viscosity: g.viscosity_pa_s,
             bulk_viscosity: g.bulk_viscosity_pa_s,
             gravity: case.gravity_m_s2,
@@ -86,7 +89,8 @@ impl GasSolver {
             ramp_time: g.ramp_time_s,
             inlet_voidage: g.inlet_voidage,
             outlet_relaxation: g.outlet_relaxation,
-            outlet_pressure: g.outlet_pressure_pa,
+            // The solver's p = c²ρ at the outlet density, c = f·a (reported pressures add the offset).
+            outlet_pressure: g.outlet_pressure_pa * g.acoustic_speed_factor * g.acoustic_speed_factor,
             cfl_factor: g.cfl_factor,
             outlet: Outlet::Characteristic,
         };
@@ -108,6 +112,7 @@ impl GasSolver {
             hist_face: Default::default(),
         };
         let mut s = GasSolver::from_state(st, grid);
+        s.anchor_pressure(g.outlet_pressure_pa);
         for c in 0..n {
             let rho = s.hydrostatic_density(c);
             s.st.q[c] = [rho, 0.0, 0.0, 0.0];
@@ -134,6 +139,7 @@ impl GasSolver {
             face_stage: vec![0.0; nf],
             parallel: n >= PARALLEL_MIN_CELLS,
             team: true,
+            pressure_offset: 0.0,
             grid,
         }
     }
@@ -237,9 +243,16 @@ impl GasSolver {
         v
     }
     /// Absolute pressure p = ρa² per cell.
+    /// Absolute pressure per cell: p = p_out + c²(ρ − ρ_out), c = f·a (`acoustic_speed_factor`).
     pub fn pressure(&self) -> Vec<f64> {
-        (0..self.st.q.len()).map(|c| self.pressure_at(c)).collect()
+        (0..self.st.q.len()).map(|c| self.pressure_at(c) + self.pressure_offset).collect()
     }
+    /// Report pressures about the case's absolute outlet pressure: the solver carries p = c²ρ,
+    /// which differs from it by a constant when c is below the sound speed (gradients are the same).
+    pub fn anchor_pressure(&mut self, outlet_pressure_pa: f64) {
+        self.pressure_offset = outlet_pressure_pa - self.st.params.outlet_pressure;
+    }
+    /// The solver's pressure c²ρ (without the reported offset).
     #[inline]
     fn pressure_at(&self, cell: usize) -> f64 {
         let a = self.st.params.sound_speed;

@@ -52,7 +52,7 @@ pub fn case_stable_time_step(case: &Case) -> Option<f64> {
     if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && radius / dr < 1e4 && (1..=64).contains(&n0)) {
         return None;
     }
-    let (a, rho) = (g.sound_speed_m_s(), g.outlet_density_kg_m3());
+    let (a, rho) = (g.acoustic_speed_m_s(), g.outlet_density_kg_m3());
     if !(ok(a) && ok(rho) && ok(g.inlet_voidage) && ok(g.cfl_factor)) {
         return None;
     }

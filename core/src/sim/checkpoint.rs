@@ -7,7 +7,8 @@
 //! refusal names the format (and writer) of the file and of this build, and the section at fault.
 //!
 //! Formats: 1–3 had no header (one bincode blob after the number); 4 is this layout; 5 adds the
-//! DEM pair pass's chunk cuts to the `dem` section.
+//! DEM pair pass's chunk cuts to the `dem` section. The `analysis` section (the run's analysis
+//! samples) is optional: a file without it resumes with an empty analysis window.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -49,6 +50,7 @@ pub(super) fn encode(st: &State) -> Vec<u8> {
         part("counters", "bincode-1", bincode_of(&(st.steps, st.snapshots_taken)), &[]),
         part("dem", "bincode-1", bincode_of(&st.dem), &dem_shapes),
         part("gas", "bincode-1", bincode_of(&st.gas), &[]),
+        part("analysis", "bincode-1", bincode_of(&st.analysis), &[]),
     ];
     let header =
         Header { format: FORMAT, writer: WRITER.into(), sections: parts.iter().map(|p| p.0.clone()).collect() };
@@ -119,7 +121,24 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
         bincode::deserialize(section("counters")?).map_err(|e| refuse("counters", e.to_string()))?;
     let dem = bincode::deserialize(section("dem")?).map_err(|e| refuse("dem", e.to_string()))?;
     let gas = bincode::deserialize(section("gas")?).map_err(|e| refuse("gas", e.to_string()))?;
-    Ok(State { case, plan, steps, snapshots_taken, dem, gas })
+    // A checkpoint from before the run analysis starts its window afresh.
+    let analysis = match sections.get("analysis") {
+        Some(body) => bincode::deserialize(body).map_err(|e| refuse("analysis", e.to_string()))?,
+        None => super::RunAnalysis::new(&case, &super::fluid_grid(&case)),
+    };
+    Ok(State { case, plan, steps, snapshots_taken, dem, gas, analysis })
+}
+
+/// The case and the run analysis of a checkpoint, read without the particle and gas state.
+pub(super) fn analysis_of(bytes: &[u8]) -> Result<(crate::case::Case, super::RunAnalysis), String> {
+    let (header, sections) = describe(bytes)?;
+    let case_bytes = sections.get("case").ok_or_else(|| format!("checkpoint by {} has no case", header.writer))?;
+    let case: crate::case::Case = serde_json::from_slice(case_bytes).map_err(|e| format!("checkpoint case: {e}"))?;
+    let analysis = match sections.get("analysis") {
+        Some(body) => bincode::deserialize(body).map_err(|e| format!("checkpoint section analysis: {e}"))?,
+        None => super::RunAnalysis::new(&case, &super::fluid_grid(&case)),
+    };
+    Ok((case, analysis))
 }
 
 #[cfg(test)]
@@ -147,7 +166,7 @@ mod tests {
         let (header, sections) = describe(&bytes).unwrap();
         assert_eq!((header.format, header.writer.as_str()), (FORMAT, WRITER));
         let names: Vec<&str> = header.sections.iter().map(|s| s.name.as_str()).collect();
-        assert_eq!(names, ["case", "plan", "counters", "dem", "gas"]);
+        assert_eq!(names, ["case", "plan", "counters", "dem", "gas", "analysis"]);
         let dem = header.sections.iter().find(|s| s.name == "dem").unwrap();
         assert_eq!(dem.shapes["positions"], [4, 3]);
         assert_eq!(sections["dem"].len() as u64, dem.bytes);
@@ -156,7 +175,7 @@ mod tests {
         assert_eq!(back.dem().positions(), sim.dem().positions());
         // A section that no longer matches is refused with its name, shapes and both versions.
         let mut bad = bytes.clone();
-        let cut = bad.len() - sections["gas"].len() - 8;
+        let cut = bad.len() - sections["analysis"].len() - sections["gas"].len() - 8;
         bad.truncate(cut);
         let err = Simulation::restore(&bad).err().unwrap().to_string();
         assert!(err.contains("section dem cut short"), "{err}");

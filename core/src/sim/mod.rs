@@ -4,10 +4,12 @@
 mod checkpoint;
 mod coupled;
 pub mod plan;
+pub mod run_analysis;
 pub mod snapshot;
 mod watchdog;
 
 pub use plan::Plan;
+pub use run_analysis::{AnalysisReport, RunAnalysis};
 pub use snapshot::{GridInfo, ParticleSnapshot, Snapshot, SnapshotSink};
 pub use watchdog::MAX_OVERLAP_FRACTION;
 
@@ -55,6 +57,7 @@ struct State {
     snapshots_taken: u64,
     dem: DemSystem,
     gas: Option<GasSolver>,
+    analysis: RunAnalysis,
 }
 
 /// Wall time spent per stage (seconds), for progress reports and benchmarks.
@@ -104,7 +107,8 @@ impl Simulation {
         // The gas step: the stable step of the gas at rest or of the inlet flow, whichever is less.
         let inflow = crate::cfd::case_stable_time_step(&case).unwrap_or(f64::INFINITY);
         let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt().min(inflow)));
-        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas };
+        let analysis = RunAnalysis::new(&case, &grid);
+        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas, analysis };
         let mut sim = Simulation::assemble(st, grid);
         sim.initial_voidage();
         Ok(sim)
@@ -187,6 +191,11 @@ impl Simulation {
                 break;
             }
             self.step()?;
+            if self.st.analysis.due(self.st.steps, self.st.dem.time()) {
+                let t0 = std::time::Instant::now();
+                self.sample_analysis();
+                self.timers.output += t0.elapsed().as_secs_f64();
+            }
             if self.st.steps.is_multiple_of(self.steps_per_snapshot) || self.st.steps == self.end_steps {
                 let t0 = std::time::Instant::now();
                 let s = self.take_snapshot();
@@ -195,6 +204,42 @@ impl Simulation {
             }
         }
         Ok(None)
+    }
+
+    /// The analysis of the samples so far (case `analysis`).
+    pub fn analysis_report(&self) -> AnalysisReport {
+        self.st.analysis.report(&self.grid)
+    }
+
+    /// The analysis held in a checkpoint (`checkpoint`), read without restoring the run: the
+    /// case's grid and the report of its samples.
+    pub fn analysis_of_checkpoint(bytes: &[u8]) -> Result<(Case, CylGrid, AnalysisReport), SimError> {
+        let (case, analysis) = checkpoint::analysis_of(bytes).map_err(SimError::Checkpoint)?;
+        let grid = fluid_grid(&case);
+        let report = analysis.report(&grid);
+        Ok((case, grid, report))
+    }
+
+    /// One analysis sample of now (the voidage of the last coupling in a coupled run).
+    fn sample_analysis(&mut self) {
+        if self.st.plan.voidage_field && !self.st.plan.coupling {
+            self.refresh_voidage_field();
+        }
+        let (pressure, vel) = match &self.st.gas {
+            Some(g) => {
+                (Some(g.pressure()), Some((0..self.grid.num_cells()).map(|c| g.velocity_cyl(c)).collect::<Vec<_>>()))
+            }
+            None => (None, None),
+        };
+        let sample = run_analysis::Sample {
+            time_s: self.st.dem.time(),
+            voidage: &self.buf.voidage,
+            pressure_pa: pressure.as_deref(),
+            gas_velocity: vel.as_deref(),
+            positions: self.st.dem.positions(),
+            velocities: self.st.dem.velocities(),
+        };
+        self.st.analysis.add(&self.grid, &sample);
     }
 
     /// Run to the end, handing every snapshot to `sink`.
@@ -217,6 +262,9 @@ impl Simulation {
         let st = checkpoint::decode(bytes).map_err(SimError::Checkpoint)?;
         let grid = fluid_grid(&st.case);
         let mut sim = Simulation::assemble(st, grid);
+        if let (Some(gas), Some(g)) = (sim.st.gas.as_mut(), sim.st.case.gas.as_ref()) {
+            gas.anchor_pressure(g.outlet_pressure_pa);
+        }
         // A coupled run holds the voidage of its last coupling, which the gas holds too.
         match (&sim.st.gas, sim.st.plan.coupling) {
             (Some(gas), true) => sim.buf.voidage.copy_from_slice(gas.voidage()),

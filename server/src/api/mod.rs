@@ -2,6 +2,7 @@
 //! registered through utoipa-axum from its handler's `#[utoipa::path]`, so the OpenAPI document
 //! (openapi.rs) lists exactly what is routed.
 
+mod analysis;
 mod downloads;
 mod jobs;
 pub mod openapi;
@@ -30,6 +31,8 @@ pub fn routes() -> OpenApiRouter<Arc<App>> {
         .routes(routes!(downloads::list))
         .routes(routes!(downloads::one))
         .routes(routes!(downloads::pressure_drop))
+        .routes(routes!(analysis::get))
+        .routes(routes!(analysis::figure))
         .routes(routes!(schema))
         .routes(routes!(openapi::serve))
         .routes(routes!(healthz))

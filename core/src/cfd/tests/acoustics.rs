@@ -10,7 +10,18 @@ const DZ: f64 = 0.005;
 /// A 1-m tube (3 sector cells per layer) with uniform flow U and a Gaussian density pulse of
 /// relative amplitude 1e-3 and standard deviation `width` at z0; `right_going` adds the velocity of a pure up-going wave.
 fn tube(u: f64, z0: f64, width: f64, right_going: bool) -> (GasSolver, f64) {
-    let gas = Gas { superficial_velocity_m_s: u, ramp_time_s: 0.0, inlet_voidage: 1.0, ..Default::default() };
+    tube_at(1.0, u, z0, width, right_going)
+}
+
+/// `tube` with the pressure waves at `factor` times the sound speed (`acoustic_speed_factor`).
+fn tube_at(factor: f64, u: f64, z0: f64, width: f64, right_going: bool) -> (GasSolver, f64) {
+    let gas = Gas {
+        superficial_velocity_m_s: u,
+        ramp_time_s: 0.0,
+        inlet_voidage: 1.0,
+        acoustic_speed_factor: factor,
+        ..Default::default()
+    };
     let mut s = solver(gas, 0.0, 1, 0.01, NZ, DZ);
     let (rho0, a) = (s.density(0), s.params().sound_speed);
     for c in 0..s.grid().num_cells() {
@@ -44,10 +55,20 @@ fn run_to(s: &mut GasSolver, t: f64) {
 
 #[test]
 fn acoustic_pulse_travels_at_a_plus_and_minus_u() {
-    let u = 20.0;
-    let (mut s, rho0) = tube(u, 0.4, 0.03, false);
+    pulse_speeds(1.0, 20.0, 0.4e-3, 1.0e-3);
+}
+
+#[test]
+fn with_a_quarter_of_the_sound_speed_a_pulse_travels_at_a_quarter_a_plus_and_minus_u() {
+    let a = Gas::default().sound_speed_m_s();
+    let s = pulse_speeds(0.25, 5.0, 1.6e-3, 4.0e-3);
+    assert!((s / (0.25 * a) - 1.0).abs() < 1e-12, "the solver's wave speed {s} is not a/4 = {}", 0.25 * a);
+}
+
+/// Up- and down-going pulse speeds against f·a ± U between times t1 and t2; returns f·a.
+fn pulse_speeds(factor: f64, u: f64, t1: f64, t2: f64) -> f64 {
+    let (mut s, rho0) = tube_at(factor, u, 0.4, 0.03, false);
     let a = s.params().sound_speed;
-    let (t1, t2) = (0.4e-3, 1.0e-3);
     run_to(&mut s, t1);
     let p1 = profile(&s, rho0);
     let (up1, down1) = (peak(&p1, 81, 199), peak(&p1, 1, 80));
@@ -57,6 +78,7 @@ fn acoustic_pulse_travels_at_a_plus_and_minus_u() {
     let (c_up, c_down) = ((up2 - up1) / (t2 - t1), (down1 - down2) / (t2 - t1));
     assert!((c_up / (a + u) - 1.0).abs() < 0.02, "up-going pulse at {c_up} m/s, want a + U = {}", a + u);
     assert!((c_down / (a - u) - 1.0).abs() < 0.02, "down-going pulse at {c_down} m/s, want a − U = {}", a - u);
+    a
 }
 
 /// Largest |ρ'| left in the tube after an up-going pulse of amplitude 1e-3ρ0 and width 0.05 m

@@ -50,3 +50,38 @@ fn pressure_gradient_of_the_initial_state_is_minus_rho_g_everywhere() {
         assert!(g[0].abs() < 1e-8 && g[1].abs() < 1e-8, "cell {c}: horizontal gradient {g:?}");
     }
 }
+
+#[test]
+fn a_slowed_acoustic_speed_keeps_the_outlet_pressure_the_density_and_the_hydrostatic_drop() {
+    // p = p_out + c²(ρ − ρ_out), c = a/4: the reported top pressure is the outlet's (half a layer of
+    // hydrostatic head below it), the density the air's at p_out, the column's drop ρ g (H − dz).
+    let (nz, dz) = (40, 0.0025);
+    let gas = Gas { acoustic_speed_factor: 0.25, ..Default::default() };
+    let (p_out, rho_out) = (gas.outlet_pressure_pa, gas.outlet_density_kg_m3());
+    let s = solver(gas, 9.81, 3, 0.004, nz, dz);
+    let p = s.pressure();
+    let layer_p = |k: usize| layer_mean(&s, k, |c| p[c]);
+    let head = rho_out * 9.81;
+    assert!((layer_p(nz - 1) - (p_out + 0.5 * dz * head)).abs() < 1e-3 * dz * head, "top {}", layer_p(nz - 1));
+    let drop = layer_p(0) - layer_p(nz - 1);
+    assert!((drop / (head * (nz - 1) as f64 * dz) - 1.0).abs() < 1e-3, "drop {drop} Pa");
+    for c in 0..s.grid().num_cells() {
+        assert!((s.density(c) / rho_out - 1.0).abs() < 1e-3, "cell {c}: ρ = {}", s.density(c));
+    }
+    // ∇p is −ρg as at the full sound speed.
+    for c in 0..s.grid().num_cells() {
+        let g = s.pressure_gradient_cyl(c);
+        assert!((g[2] / (-s.density(c) * 9.81) - 1.0).abs() < 1e-4, "cell {c}: ∂p/∂z = {}", g[2]);
+    }
+}
+
+#[test]
+fn the_stable_gas_step_grows_as_one_over_the_acoustic_speed_factor() {
+    let step = |f: f64| {
+        let gas = Gas { acoustic_speed_factor: f, superficial_velocity_m_s: 0.0, ..Default::default() };
+        solver(gas, 9.81, 5, 0.0044, 20, 0.0022).stable_dt()
+    };
+    let ratio = step(0.25) / step(1.0);
+    // Gas at rest: the acoustic limit scales as 1/f; the viscous part (~1e-4 of it) does not.
+    assert!((ratio / 4.0 - 1.0).abs() < 1e-3, "stable step ratio {ratio}, want 4");
+}

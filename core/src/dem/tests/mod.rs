@@ -32,6 +32,7 @@ pub fn test_case(col_d: f64, height: f64, lid: bool, gravity: f64, dt: f64) -> C
         grid: Default::default(),
         voidage: Default::default(),
         coupling: Default::default(),
+        analysis: Default::default(),
     };
     c.dem.time_step_s = dt;
     c

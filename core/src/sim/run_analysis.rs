@@ -1,0 +1,317 @@
+//! The paper's analyses accumulated while a run goes (case `analysis`): every `sample_interval_s`
+//! from `from_s` on, the bed pressure drop, the layer means of the voidage, the bubble fraction,
+//! the particle-based averages (Boyce et al. 2013) and the field averages take one sample; the
+//! state travels in the checkpoint's `analysis` section, so a resumed job keeps its window.
+//! `report` turns the sums into the statistics of `analysis` (no sample is kept beyond the ΔP
+//! series and the layer means).
+//!
+//! Choices (stated in docs/VALIDATION.md "Analysis during a run"): the bed height is the top of
+//! the highest layer whose time-averaged voidage is below 0.8; bubbles are counted where the
+//! cross-section mean voidage at the lower rise height rises through its time mean + one standard
+//! deviation after it was last below its mean (`count_bubbles`' hysteresis); the Welch segments
+//! are the longest power of two with at least four half-overlapping segments in the record; the
+//! rise velocity searches delays up to half the record.
+
+use crate::analysis::{
+    axial_map, bed_pressure_drop, count_bubbles, dominant_frequency, layer_means, radial_profile, rise_velocity,
+    signal_stats, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, FieldAverage, LayerSeries, ParticleAverage,
+    RadialProfile, RiseVelocity, Spectrum,
+};
+use crate::case::{AnalysisSpec, Case};
+use crate::grid::CylGrid;
+use serde::{Deserialize, Serialize};
+
+/// Cell voidage below which a layer counts as bed, for the bed height.
+const BED_VOIDAGE: f64 = 0.8;
+
+/// The accumulated samples of one run.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunAnalysis {
+    spec: AnalysisSpec,
+    /// DEM steps between samples.
+    every: u64,
+    first_s: Option<f64>,
+    last_s: f64,
+    pressure_drop_pa: Vec<f64>,
+    voidage_layers: LayerSeries,
+    bubbles: BubbleFraction,
+    particles: ParticleAverage,
+    fields: FieldAverage,
+}
+
+/// The inputs of one sample.
+pub struct Sample<'a> {
+    pub time_s: f64,
+    pub voidage: &'a [f64],
+    /// Absolute gas pressure per cell (gas runs).
+    pub pressure_pa: Option<&'a [f64]>,
+    pub gas_velocity: Option<&'a [[f64; 3]]>,
+    pub positions: &'a [[f64; 3]],
+    pub velocities: &'a [[f64; 3]],
+}
+
+/// Everything `GET /v1/jobs/{id}/analysis` shows: each statistic with its window and samples.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct AnalysisReport {
+    pub from_s: f64,
+    pub to_s: f64,
+    pub samples: u64,
+    pub sample_interval_s: f64,
+    pub pressure_drop: Option<PressureDropStats>,
+    /// Top of the highest layer whose time-averaged voidage is below 0.8 (m).
+    pub bed_height_m: Option<f64>,
+    pub bubbles: Option<Bubbles>,
+    pub bubble_fraction: ByHeight,
+    pub rise_velocity: Option<Rise>,
+    /// Particle-based ⟨v_z⟩ (m/s) and the time-averaged voidage on the axial plane (r, z).
+    pub particle_velocity_map: AxialMap,
+    pub voidage_map: AxialMap,
+    pub radial_profiles: Vec<Profiles>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PressureDropStats {
+    pub mean_pa: f64,
+    pub std_pa: f64,
+    pub dominant_frequency_hz: Option<f64>,
+    pub spectrum: Option<Spectrum>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Bubbles {
+    pub height_m: f64,
+    /// Thresholds on the cross-section mean voidage (rise through `rise` after below `fall`).
+    pub rise: f64,
+    pub fall: f64,
+    pub count: BubbleCount,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Rise {
+    pub lower_m: f64,
+    pub upper_m: f64,
+    /// From the cross-section voidage at the two heights (Müller et al. 2007a).
+    pub voidage: Option<RiseVelocity>,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Profiles {
+    pub height_m: f64,
+    pub particle_velocity_z: RadialProfile,
+    pub voidage: RadialProfile,
+}
+
+impl RunAnalysis {
+    pub fn new(case: &Case, grid: &CylGrid) -> RunAnalysis {
+        let spec = case.analysis.clone();
+        let every = ((spec.sample_interval_s / case.dem.time_step_s).round() as u64).max(1);
+        RunAnalysis {
+            every,
+            first_s: None,
+            last_s: 0.0,
+            pressure_drop_pa: Vec::new(),
+            voidage_layers: LayerSeries::new(grid),
+            bubbles: BubbleFraction::new(grid, spec.bubble_voidage),
+            particles: ParticleAverage::new(grid),
+            fields: FieldAverage::new(grid.num_cells()),
+            spec,
+        }
+    }
+
+    /// Whether DEM step `step` at time `t` takes a sample.
+    pub fn due(&self, step: u64, t: f64) -> bool {
+        step.is_multiple_of(self.every) && t >= self.spec.from_s - 1e-12
+    }
+
+    pub fn samples(&self) -> u64 {
+        self.fields.samples()
+    }
+
+    pub fn add(&mut self, grid: &CylGrid, s: &Sample) {
+        self.first_s.get_or_insert(s.time_s);
+        self.last_s = s.time_s;
+        if let Some(p) = s.pressure_pa {
+            self.pressure_drop_pa.push(bed_pressure_drop(&layer_means(grid, p)));
+        }
+        self.voidage_layers.add_sample(s.time_s, s.voidage);
+        self.bubbles.add_sample(s.voidage);
+        self.particles.add_sample(grid, s.positions, s.velocities);
+        self.fields.add_sample(s.voidage, s.gas_velocity);
+    }
+
+    pub fn report(&self, grid: &CylGrid) -> AnalysisReport {
+        let dt = self.every_s();
+        let pressure_drop = signal_stats(&self.pressure_drop_pa).map(|st| {
+            let spectrum = welch_of(&self.pressure_drop_pa, dt);
+            PressureDropStats {
+                mean_pa: st.mean,
+                std_pa: st.std,
+                dominant_frequency_hz: spectrum.as_ref().and_then(dominant_frequency),
+                spectrum,
+            }
+        });
+        let fields = self.fields.finish();
+        let particles = self.particles.finish();
+        let voidage_map = axial_map(grid, &fields.voidage, None);
+        let weights = particles.weights();
+        let particle_velocity_map = axial_map(grid, &particles.vz(), Some(&weights));
+        let layer_voidage = layer_means(grid, &fields.voidage);
+        let bed_height_m = (self.samples() > 0)
+            .then(|| layer_voidage.iter().rposition(|&e| e < BED_VOIDAGE))
+            .flatten()
+            .map(|k| (k + 1) as f64 * grid.dz);
+        let rise_heights = self.spec.rise_heights_m.or(bed_height_m.map(|h| [0.3 * h, 0.7 * h]));
+        let bubbles = rise_heights.and_then(|[lo, _]| self.bubbles_at(lo, dt));
+        let rise_velocity = rise_heights.map(|[lo, hi]| {
+            let (a, b) = (self.voidage_layers.at_height(lo), self.voidage_layers.at_height(hi));
+            let (klo, khi) = (grid.locate_k(lo), grid.locate_k(hi));
+            let dz = (khi as f64 - klo as f64) * grid.dz;
+            let half = 0.5 * a.len() as f64 * dt;
+            Rise {
+                lower_m: lo,
+                upper_m: hi,
+                voidage: (dz > 0.0).then(|| rise_velocity(&a, &b, dt, dz, half)).flatten(),
+            }
+        });
+        let heights = if self.spec.profile_heights_m.is_empty() {
+            bed_height_m.map(|h| vec![0.5 * h]).unwrap_or_default()
+        } else {
+            self.spec.profile_heights_m.clone()
+        };
+        let radial_profiles = heights
+            .iter()
+            .map(|&z| Profiles {
+                height_m: z,
+                particle_velocity_z: radial_profile(grid, &particles.vz(), Some(&weights), z, z),
+                voidage: radial_profile(grid, &fields.voidage, None, z, z),
+            })
+            .collect();
+        AnalysisReport {
+            from_s: self.first_s.unwrap_or(self.spec.from_s),
+            to_s: self.last_s,
+            samples: self.samples(),
+            sample_interval_s: dt,
+            pressure_drop,
+            bed_height_m,
+            bubbles,
+            bubble_fraction: self.bubbles.finish(),
+            rise_velocity,
+            particle_velocity_map,
+            voidage_map,
+            radial_profiles,
+        }
+    }
+
+    /// Seconds between samples (whole DEM steps).
+    fn every_s(&self) -> f64 {
+        match (self.first_s, self.samples()) {
+            (Some(t0), n) if n > 1 => (self.last_s - t0) / (n - 1) as f64,
+            _ => self.spec.sample_interval_s,
+        }
+    }
+
+    fn bubbles_at(&self, z: f64, dt: f64) -> Option<Bubbles> {
+        let x = self.voidage_layers.at_height(z);
+        let st = signal_stats(&x)?;
+        let (rise, fall) = (st.mean + st.std, st.mean);
+        (rise > fall).then(|| Bubbles { height_m: z, rise, fall, count: count_bubbles(&x, dt, rise, fall) })
+    }
+}
+
+/// Welch's spectrum with the longest power-of-two segments that still give four segments.
+fn welch_of(x: &[f64], dt: f64) -> Option<Spectrum> {
+    let mut l = 8usize;
+    while (x.len().saturating_sub(2 * l)) / l + 1 >= 4 && 2 * l <= x.len() {
+        l *= 2;
+    }
+    welch(x, dt, l).or_else(|| welch(x, dt, 8))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// Synthetic samples whose statistics are known: a bed of ε = 0.4 below 12 mm (ε = 1 above,
+    /// a bubble of ε = 0.9 in the lower layers every 0.1 s), a pressure field whose bed drop is
+    /// 100 + 10 sin(2π·5 t) Pa, particles moving up at v_z = 0.2 − 10 r² (m/s).
+    #[test]
+    fn a_run_of_known_samples_gives_its_mean_spread_frequency_bed_height_and_particle_map() {
+        let case: Case = serde_json::from_str(
+            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
+               "dem":{"time_step_s":1e-5},"analysis":{"from_s":0.05,"sample_interval_s":0.002}}"#,
+        )
+        .unwrap();
+        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
+        let mut a = RunAnalysis::new(&case, &grid);
+        let n = grid.num_cells();
+        let per = grid.cells_per_layer();
+        let (mut t, mut taken) = (0.0, 0);
+        // Samples at 0.05, 0.052, … 1.048 s: 500 samples, five whole periods of the ΔP signal.
+        for step in 1..=104_800u64 {
+            t = step as f64 * 1e-5;
+            if !a.due(step, t) {
+                continue;
+            }
+            taken += 1;
+            let bubble = (t * 10.0).fract() < 0.3;
+            let eps: Vec<f64> = (0..n)
+                .map(|c| match (grid.centre_xyz(c)[2], bubble) {
+                    (z, _) if z > 0.012 => 1.0,
+                    (z, true) if z < 0.006 => 0.9,
+                    _ => 0.4,
+                })
+                .collect();
+            // p linear in the layer index: the bed drop (plate to the top two layers' mean) is
+            // slope · (nz − 1) layers.
+            let dp = 100.0 + 10.0 * (2.0 * PI * 5.0 * t).sin();
+            let slope = dp / (grid.nz as f64 - 1.0);
+            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
+            let pos: Vec<[f64; 3]> = (0..n).map(|c| grid.centre_xyz(c)).collect();
+            let vel: Vec<[f64; 3]> = pos.iter().map(|x| [0.0, 0.0, 0.2 - 10.0 * (x[0] * x[0] + x[1] * x[1])]).collect();
+            a.add(
+                &grid,
+                &Sample {
+                    time_s: t,
+                    voidage: &eps,
+                    pressure_pa: Some(&p),
+                    gas_velocity: None,
+                    positions: &pos,
+                    velocities: &vel,
+                },
+            );
+        }
+        let r = a.report(&grid);
+        assert_eq!(r.samples, taken);
+        assert!(
+            (r.from_s - 0.05).abs() < 1e-9 && (r.to_s - t).abs() < 1e-9 && (r.sample_interval_s - 0.002).abs() < 1e-12
+        );
+        let dp = r.pressure_drop.as_ref().unwrap();
+        assert!((dp.mean_pa - 100.0).abs() < 0.01, "mean {}", dp.mean_pa);
+        assert!((dp.std_pa / (10.0 / 2f64.sqrt()) - 1.0).abs() < 0.01, "std {}", dp.std_pa);
+        let f = dp.dominant_frequency_hz.unwrap();
+        assert!((f - 5.0).abs() <= dp.spectrum.as_ref().unwrap().df_hz, "dominant {f} Hz");
+        assert!((r.bed_height_m.unwrap() - 0.012).abs() < 1e-12, "bed height {:?}", r.bed_height_m);
+        // Bubbles: 10 per second in the lower rise height (0.3 × 12 mm = 3.6 mm, inside the bubble zone).
+        let b = r.bubbles.as_ref().unwrap();
+        let rate = b.count.per_second;
+        assert!((rate - 10.0).abs() < 0.5, "bubbles per second {rate}");
+        // Particle velocity on the axial plane: the annulus means of 0.2 − 10 r² at the cell centres.
+        for k in 0..grid.nz {
+            for i in 0..grid.nr {
+                let want: f64 = (0..grid.cells_in_annulus(i))
+                    .map(|j| {
+                        let x = grid.centre_xyz(grid.index(i, j, k));
+                        0.2 - 10.0 * (x[0] * x[0] + x[1] * x[1])
+                    })
+                    .sum::<f64>()
+                    / grid.cells_in_annulus(i) as f64;
+                let got = r.particle_velocity_map.value[k * grid.nr + i];
+                assert!((got - want).abs() < 1e-12, "({i}, {k}): {got} vs {want}");
+            }
+        }
+        // The profile at half the bed height, 6 mm, is layer 3's.
+        assert_eq!(r.radial_profiles.len(), 1);
+        assert!((r.radial_profiles[0].height_m - 0.006).abs() < 1e-12);
+    }
+}

@@ -1,0 +1,168 @@
+//! The job's analysis (case `analysis`, accumulated while it runs): the statistics as JSON and
+//! their figures as PNG, read from the job's last checkpoint (its `analysis` section only, so a
+//! large bed is not decoded for a request).
+
+use super::jobs::find;
+use super::problem::{internal, problem};
+use crate::App;
+use axum::extract::{Path, State};
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::Json;
+use fluidbed_core::grid::CylGrid;
+use fluidbed_core::output::plot;
+use fluidbed_core::sim::{AnalysisReport, Simulation};
+use std::sync::Arc;
+
+/// The figures `GET /v1/jobs/{id}/analysis/{figure}` draws.
+const FIGURES: [&str; 4] =
+    ["pressure_spectrum.png", "rise_correlation.png", "particle_velocity_map.png", "voidage_map.png"];
+
+/// The report of the job's last checkpoint, or the problem to answer with.
+async fn report(app: &Arc<App>, id: &str) -> Result<(CylGrid, AnalysisReport, String), Response> {
+    let job = find(app, id)?;
+    let a = app.clone();
+    let job_id = id.to_string();
+    let bytes = match tokio::task::spawn_blocking(move || a.store.checkpoint(&job_id)).await {
+        Ok(Ok(Some(b))) => b,
+        Ok(Ok(None)) => {
+            return Err(problem(
+                StatusCode::NOT_FOUND,
+                "No analysis yet",
+                "the job has not written a checkpoint yet (its analysis is read from the last one)",
+            ))
+        }
+        Ok(Err(e)) => return Err(internal(e)),
+        Err(e) => return Err(internal(e.into())),
+    };
+    match tokio::task::spawn_blocking(move || Simulation::analysis_of_checkpoint(&bytes)).await {
+        Ok(Ok((_, grid, r))) => Ok((grid, r, job.name)),
+        Ok(Err(e)) => Err(internal(anyhow::anyhow!("{e}"))),
+        Err(e) => Err(internal(e.into())),
+    }
+}
+
+/// Every statistic of the run so far with its window and sample count: ΔP mean, spread, Welch
+/// spectrum and dominant frequency; the bed height; bubbles per second and the bubble fraction by
+/// height; the rise velocity by cross-correlation; particle-based and voidage maps on the axial
+/// plane and radial profiles (docs/VALIDATION.md "Analysis during a run").
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/analysis",
+    operation_id = "get_analysis",
+    tag = "results",
+    params(("id" = String, Path, description = "The job id")),
+    responses(
+        (status = 200, description = "The analysis as of the job's last checkpoint", body = Object),
+        (status = 404, description = "No such job, or no checkpoint yet", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
+    )
+)]
+pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
+    match report(&app, &id).await {
+        Ok((_, r, _)) => Json(r).into_response(),
+        Err(r) => r,
+    }
+}
+
+/// One figure of the analysis: `pressure_spectrum.png` (Welch PSD of ΔP),
+/// `rise_correlation.png` (the voidage cross-correlation between the two rise heights),
+/// `particle_velocity_map.png` (particle-based ⟨v_z⟩ on the axial plane, as the paper's Fig. 7),
+/// `voidage_map.png` (time-averaged voidage on the axial plane, Fig. 6).
+#[utoipa::path(
+    get,
+    path = "/v1/jobs/{id}/analysis/{figure}",
+    operation_id = "get_analysis_figure",
+    tag = "results",
+    params(
+        ("id" = String, Path, description = "The job id"),
+        ("figure" = String, Path, description = "pressure_spectrum.png, rise_correlation.png, particle_velocity_map.png or voidage_map.png"),
+    ),
+    responses(
+        (status = 200, description = "The figure", body = fluidbed_api::Binary, content_type = "image/png"),
+        (status = 404, description = "No such job or figure, no checkpoint yet, or too few samples for it",
+            body = fluidbed_api::Problem, content_type = "application/problem+json"),
+    )
+)]
+pub async fn figure(State(app): State<Arc<App>>, Path((id, figure)): Path<(String, String)>) -> Response {
+    if !FIGURES.contains(&figure.as_str()) {
+        return problem(
+            StatusCode::NOT_FOUND,
+            "Not found",
+            &format!("no such figure; the figures are {}", FIGURES.join(", ")),
+        );
+    }
+    let (grid, r, name) = match report(&app, &id).await {
+        Ok(x) => x,
+        Err(r) => return r,
+    };
+    match tokio::task::spawn_blocking(move || draw(&grid, &r, &name, &figure)).await {
+        Ok(r) => r,
+        Err(e) => internal(e.into()),
+    }
+}
+
+fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Response {
+    let window = format!("{:.3}–{:.3} s, {} samples", r.from_s, r.to_s, r.samples);
+    let too_few = |what: &str| problem(StatusCode::NOT_FOUND, "Not enough samples", &format!("{what} ({window})"));
+    let image = match figure {
+        "pressure_spectrum.png" => {
+            let Some(s) = r.pressure_drop.as_ref().and_then(|p| p.spectrum.as_ref()) else {
+                return too_few("no ΔP spectrum yet: a gas run needs at least 8 samples");
+            };
+            let title = format!("{job_name}: ΔP spectrum, {window}");
+            let labels =
+                plot::TraceLabels { title: &title, x: "frequency f [Hz]", y: "power spectral density [Pa²/Hz]" };
+            plot::trace(&s.freq_hz, &s.psd, &labels)
+        }
+        "rise_correlation.png" => {
+            let Some((rise, v)) = r.rise_velocity.as_ref().and_then(|x| Some((x, x.voidage.as_ref()?))) else {
+                return too_few("no correlation peak between the rise heights yet");
+            };
+            let lag: Vec<f64> = (0..v.correlation.len()).map(|k| k as f64 * v.dt_s).collect();
+            let title = format!(
+                "{job_name}: voidage correlation {:.0}–{:.0} mm, u = {:.3} m/s, {window}",
+                1e3 * rise.lower_m,
+                1e3 * rise.upper_m,
+                v.velocity_m_s
+            );
+            let labels = plot::TraceLabels { title: &title, x: "delay τ [s]", y: "cross-correlation R(τ) [-]" };
+            plot::trace(&lag, &v.correlation, &labels)
+        }
+        "particle_velocity_map.png" => {
+            let field = axisymmetric(grid, &r.particle_velocity_map.value);
+            let top = field.iter().filter(|v| v.is_finite()).fold(0.0f64, |m, v| m.max(v.abs()));
+            let title = format!("{job_name}: particle ⟨v_z⟩, {window}");
+            let labels =
+                plot::FieldLabels { title: &title, quantity: "particle-based ⟨v_z⟩ [m/s]", lo: -top, hi: top };
+            plot::axial_slice(grid, &field, &labels)
+        }
+        _ => {
+            let field = axisymmetric(grid, &r.voidage_map.value);
+            let title = format!("{job_name}: time-averaged voidage, {window}");
+            let labels = plot::FieldLabels { title: &title, quantity: "⟨ε⟩ [-]", lo: 0.3, hi: 1.0 };
+            plot::axial_slice(grid, &field, &labels)
+        }
+    };
+    match image {
+        Ok(img) => {
+            let disposition = format!("attachment; filename=\"{figure}\"");
+            (
+                [(header::CONTENT_TYPE, "image/png".to_string()), (header::CONTENT_DISPOSITION, disposition)],
+                img.encode(),
+            )
+                .into_response()
+        }
+        Err(e) => internal(e.into()),
+    }
+}
+
+/// A cell field from azimuthal means `value[k · nr + i]` (each cell its annulus's value).
+fn axisymmetric(grid: &CylGrid, value: &[f64]) -> Vec<f64> {
+    (0..grid.num_cells())
+        .map(|c| {
+            let (i, _, k) = grid.ijk(c);
+            value[k * grid.nr + i]
+        })
+        .collect()
+}
