@@ -22,7 +22,13 @@ pub struct RunSummary {
     /// vertical components in N and kg m/s (empty in runs kept by earlier builds).
     #[serde(default)]
     pub budget: Vec<[f64; 5]>,
+    /// The run's analysis from `ANALYSIS_FROM_S` to the end (`Simulation::analysis_report`).
+    #[serde(default)]
+    pub analysis: Option<fluidbed_core::sim::AnalysisReport>,
 }
+
+/// Start of the run's analysis window: after the 240-ms ramp and the first eruptions, as `fluidized`.
+pub const ANALYSIS_FROM_S: f64 = 0.4;
 
 /// Simulated seconds of the run both validations read (`FLUIDBED_BUBBLING_END_S` overrides).
 pub fn end_s() -> f64 {
@@ -43,6 +49,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
     case.end_time_s = end_s;
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
+    case.analysis.from_s = ANALYSIS_FROM_S;
     // named after the case it ran, so an edited case runs anew
     let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
     let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.json");
@@ -119,6 +126,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
         bubble_fraction_max: p.bubble_fraction_max,
         wall_s: wall_before + t0.elapsed().as_secs_f64(),
         budget: p.budget,
+        analysis: Some(sim.analysis_report()),
     };
     std::fs::create_dir_all("target/validate-cache").expect("cache dir");
     write_atomically(cache, serde_json::to_string(&r).unwrap().as_bytes());

@@ -3,6 +3,7 @@
 
 mod analysis_signals;
 mod bubbling;
+mod bubbling_stats;
 mod common;
 mod fig3;
 mod fluidized;
@@ -25,6 +26,7 @@ fn main() {
         "fig3" => report(fig3::run()),
         "umf" => report(umf::run()),
         "bubbling" => report(bubbling::run()),
+        "bubbling-stats" => report(bubbling_stats::run()),
         "analysis-signals" => report(analysis_signals::run()),
         // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
         "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),

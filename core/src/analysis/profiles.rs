@@ -72,6 +72,18 @@ pub struct AxialMap {
     pub value: Vec<f64>,
 }
 
+impl AxialMap {
+    /// The map as a cell field of `grid` (each cell its annulus's value), for the axial-slice picture.
+    pub fn cell_field(&self, grid: &CylGrid) -> Vec<f64> {
+        (0..grid.num_cells())
+            .map(|c| {
+                let (i, _, k) = grid.ijk(c);
+                self.value[k * self.nr + i]
+            })
+            .collect()
+    }
+}
+
 pub fn axial_map(grid: &CylGrid, values: &[f64], weights: Option<&[f64]>) -> AxialMap {
     let value = (0..grid.nz).flat_map(|k| annulus_means(grid, values, weights, k, k).0).collect();
     AxialMap {

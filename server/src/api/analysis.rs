@@ -130,7 +130,7 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
             plot::trace(&lag, &v.correlation, &labels)
         }
         "particle_velocity_map.png" => {
-            let field = axisymmetric(grid, &r.particle_velocity_map.value);
+            let field = r.particle_velocity_map.cell_field(grid);
             let top = field.iter().filter(|v| v.is_finite()).fold(0.0f64, |m, v| m.max(v.abs()));
             let title = format!("{job_name}: particle ⟨v_z⟩, {window}");
             let labels =
@@ -138,7 +138,7 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
             plot::axial_slice(grid, &field, &labels)
         }
         _ => {
-            let field = axisymmetric(grid, &r.voidage_map.value);
+            let field = r.voidage_map.cell_field(grid);
             let title = format!("{job_name}: time-averaged voidage, {window}");
             let labels = plot::FieldLabels { title: &title, quantity: "⟨ε⟩ [-]", lo: 0.3, hi: 1.0 };
             plot::axial_slice(grid, &field, &labels)
@@ -155,14 +155,4 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
         }
         Err(e) => internal(e.into()),
     }
-}
-
-/// A cell field from azimuthal means `value[k · nr + i]` (each cell its annulus's value).
-fn axisymmetric(grid: &CylGrid, value: &[f64]) -> Vec<f64> {
-    (0..grid.num_cells())
-        .map(|c| {
-            let (i, _, k) = grid.ijk(c);
-            value[k * grid.nr + i]
-        })
-        .collect()
 }
