@@ -13,6 +13,7 @@ use futures_util::StreamExt;
 use std::future::Future;
 use std::time::Duration;
 use tokio::sync::mpsc;
+use tokio_postgres::types::ToSql;
 use tokio_postgres::{AsyncMessage, NoTls, Row};
 
 mod migrations {
@@ -31,6 +32,9 @@ const NOW: &str = "EXTRACT(EPOCH FROM clock_timestamp())::float8";
 
 const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts";
 const INFO_COLUMNS: &str = "n, time_s, step, pressure_drop_pa, mean_particle_height_m";
+
+/// The parameters of one statement, owned (they travel to the runtime's task).
+type Params = Vec<Box<dyn ToSql + Send + Sync>>;
 
 pub struct Postgres {
     rt: Option<tokio::runtime::Runtime>,
@@ -194,27 +198,21 @@ impl Postgres {
     }
 
     /// Run one statement; the rows changed.
-    fn execute(
-        &self,
-        sql: &'static str,
-        params: Vec<Box<dyn tokio_postgres::types::ToSql + Send + Sync>>,
-    ) -> Result<u64> {
+    fn execute(&self, sql: &'static str, params: Params) -> Result<u64> {
         let pool = self.pool.clone();
         self.run(async move {
             let c = pool.get().await?;
-            let refs: Vec<&(dyn tokio_postgres::types::ToSql + Sync)> =
-                params.iter().map(|p| &**p as &(dyn tokio_postgres::types::ToSql + Sync)).collect();
+            let refs: Vec<&(dyn ToSql + Sync)> = params.iter().map(|p| &**p as &(dyn ToSql + Sync)).collect();
             Ok(c.execute(sql, &refs).await?)
         })
     }
 
     /// Run one query; its rows.
-    fn query(&self, sql: String, params: Vec<Box<dyn tokio_postgres::types::ToSql + Send + Sync>>) -> Result<Vec<Row>> {
+    fn query(&self, sql: String, params: Params) -> Result<Vec<Row>> {
         let pool = self.pool.clone();
         self.run(async move {
             let c = pool.get().await?;
-            let refs: Vec<&(dyn tokio_postgres::types::ToSql + Sync)> =
-                params.iter().map(|p| &**p as &(dyn tokio_postgres::types::ToSql + Sync)).collect();
+            let refs: Vec<&(dyn ToSql + Sync)> = params.iter().map(|p| &**p as &(dyn ToSql + Sync)).collect();
             Ok(c.query(&sql, &refs).await?)
         })
     }
@@ -222,7 +220,7 @@ impl Postgres {
 
 macro_rules! params {
     ($($p:expr),* $(,)?) => {
-        vec![$(Box::new($p) as Box<dyn tokio_postgres::types::ToSql + Send + Sync>),*]
+        vec![$(Box::new($p) as Box<dyn ToSql + Send + Sync>),*]
     };
 }
 
@@ -281,7 +279,7 @@ impl Records for Postgres {
             format!(
                 "UPDATE jobs SET owner = $1, lease_until = {NOW} + $2 WHERE id = (SELECT id FROM jobs \
                  WHERE status IN ('queued', 'running') AND (lease_until IS NULL OR lease_until < {NOW}) \
-                 ORDER BY seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING id"
+                 ORDER BY status = 'running' DESC, seq LIMIT 1 FOR UPDATE SKIP LOCKED) RETURNING id"
             ),
             params![s(node), lease_s],
         )?;

@@ -56,8 +56,8 @@ pub trait Records: Send + Sync {
     fn list(&self, status: Option<Status>, limit: usize, offset: usize) -> Result<(Vec<Job>, usize)>;
     fn count(&self, status: Status) -> Result<usize>;
 
-    /// Take the oldest unfinished job that no live lease holds (queued, or running on a node
-    /// whose lease ran out), atomically: no two nodes get the same one.
+    /// Take an unfinished job that no live lease holds (running on a node whose lease ran out
+    /// first, then queued; oldest first), atomically: no two nodes get the same one.
     fn claim(&self, node: &str, lease_s: f64) -> Result<Option<String>>;
     /// Extend `node`'s lease on a running job.
     fn renew(&self, id: &str, node: &str, lease_s: f64) -> Result<Lease>;
@@ -101,4 +101,20 @@ pub trait Records: Send + Sync {
 /// Now as Unix seconds (the SQLite backend's lease clock).
 pub fn unix_now() -> f64 {
     std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map(|d| d.as_secs_f64()).unwrap_or(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_notice_survives_its_wire_form() {
+        for (kind, n) in [(EventKind::Snapshot, Some(7)), (EventKind::End, None)] {
+            let notice = Notice { node: "a1".into(), job: "00ff".into(), kind, n };
+            let payload = notice.to_payload();
+            assert!(payload.len() < 200, "{payload}");
+            assert_eq!(Notice::from_payload(&payload), Some(notice));
+        }
+        assert_eq!(Notice::from_payload(r#"{"node":"a","job":"b","kind":"bogus"}"#), None);
+    }
 }

@@ -147,7 +147,7 @@ impl Records for Sqlite {
             .db()
             .query_row(
                 "UPDATE jobs SET owner = ?1, lease_until = ?2 WHERE id = (SELECT id FROM jobs \
-                 WHERE status IN ('queued', 'running') AND (lease_until IS NULL OR lease_until < ?3) ORDER BY seq LIMIT 1) \
+                 WHERE status IN ('queued', 'running') AND (lease_until IS NULL OR lease_until < ?3) ORDER BY status = 'running' DESC, seq LIMIT 1) \
                  RETURNING id",
                 params![node, now + lease_s, now],
                 |r| r.get(0),
@@ -277,5 +277,79 @@ impl Records for Sqlite {
         let real = std::mem::replace(&mut *db, Connection::open_in_memory()?);
         real.close().map_err(|(_, e)| e)?;
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::job::now_rfc3339;
+
+    fn job(id: &str) -> Job {
+        Job {
+            id: id.into(),
+            name: id.into(),
+            status: Status::Queued,
+            created_at: now_rfc3339(),
+            started_at: None,
+            finished_at: None,
+            time_s: 0.0,
+            end_time_s: 1.0,
+            steps: 0,
+            wall_s: 0.0,
+            eta_s: None,
+            message: None,
+            warnings: vec![],
+            plan: None,
+            cancel_requested: false,
+            attempts: 0,
+        }
+    }
+
+    fn records(tag: &str) -> (Sqlite, std::path::PathBuf) {
+        let dir = std::env::temp_dir().join(format!("fluidbed-sqlite-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        (Sqlite::open(&dir.join("fluidbed.sqlite")).unwrap(), dir)
+    }
+
+    #[test]
+    fn a_live_lease_keeps_a_job_and_an_expired_one_hands_it_over() {
+        let (r, dir) = records("lease");
+        r.insert(&job("one"), "{}").unwrap();
+        assert_eq!(r.claim("a", 60.0).unwrap().as_deref(), Some("one"));
+        assert!(r.set_running("one", &now_rfc3339()).unwrap());
+        assert_eq!(r.claim("b", 60.0).unwrap(), None, "held by a");
+        assert_eq!(r.renew("one", "a", -1.0).unwrap(), Lease::Held { cancel_requested: false });
+        // a's lease has now run out: b takes the job, a loses it and cannot end it.
+        assert_eq!(r.claim("b", 60.0).unwrap().as_deref(), Some("one"));
+        assert_eq!(r.renew("one", "a", 60.0).unwrap(), Lease::Lost);
+        assert!(!r.finish("one", Status::Succeeded, None, &now_rfc3339(), Some("a")).unwrap());
+        assert!(r.request_cancel("one").unwrap());
+        assert_eq!(r.renew("one", "b", 60.0).unwrap(), Lease::Held { cancel_requested: true });
+        assert!(r.finish("one", Status::Cancelled, None, &now_rfc3339(), Some("b")).unwrap());
+        assert_eq!(r.renew("one", "b", 60.0).unwrap(), Lease::Lost, "a final job has no lease");
+        assert_eq!(r.claim("c", 60.0).unwrap(), None);
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn a_running_job_is_claimed_before_older_queued_ones_and_reopening_frees_leases() {
+        let (r, dir) = records("order");
+        for id in ["old", "new"] {
+            r.insert(&job(id), "{}").unwrap();
+        }
+        assert_eq!(r.claim("a", 60.0).unwrap().as_deref(), Some("old"));
+        r.release("old", "a", false).unwrap();
+        assert_eq!(r.claim("a", 60.0).unwrap().as_deref(), Some("old"), "released: free again");
+        assert_eq!(r.claim("a", 60.0).unwrap().as_deref(), Some("new"));
+        assert!(r.set_running("new", &now_rfc3339()).unwrap());
+        drop(r);
+        let r = Sqlite::open(&dir.join("fluidbed.sqlite")).unwrap();
+        assert_eq!(r.claim("b", 60.0).unwrap().as_deref(), Some("new"), "the running job resumes first");
+        assert_eq!(r.claim("b", 60.0).unwrap().as_deref(), Some("old"));
+        assert!(r.cancel_queued("old", "cancelled before it started", &now_rfc3339()).unwrap());
+        assert!(!r.set_running("old", &now_rfc3339()).unwrap(), "a cancelled job does not start");
+        let _ = std::fs::remove_dir_all(dir);
     }
 }
