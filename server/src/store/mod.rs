@@ -18,7 +18,7 @@ mod sqlite;
 use crate::job::{Job, SnapshotInfo, Status};
 use anyhow::{bail, Context, Result};
 use fluidbed_core::sim::snapshot::Snapshot;
-pub use records::{Lease, Notice, NoticeSink, Records};
+pub use records::{EventKind, Lease, Notice, NoticeSink, Records};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
