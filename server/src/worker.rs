@@ -1,6 +1,7 @@
-//! Worker threads: each takes a job from the queue and runs it on its own rayon pool, never on
-//! the async runtime. Between chunks of steps it checks for cancellation, stores snapshots,
-//! writes checkpoints atomically, and publishes progress.
+//! Worker threads: each claims a job from the store's queue (holding its lease, heartbeat.rs)
+//! and runs it on its own rayon pool, never on the async runtime. Between chunks of steps it
+//! checks for cancellation and a lost lease, stores snapshots, writes checkpoints atomically, and
+//! publishes progress.
 
 use crate::events::{snapshot_payload, EventKind, JobEvent};
 use crate::job::{now_rfc3339, SnapshotInfo, Status};
