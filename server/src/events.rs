@@ -11,7 +11,7 @@ use fluidbed_core::output::fields;
 use fluidbed_core::sim::snapshot::Snapshot;
 use serde::Serialize;
 use std::collections::HashMap;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 use tokio::sync::{broadcast, mpsc};
 
 /// One event as broadcast to live listeners.
@@ -37,10 +37,14 @@ impl JobEvent {
     }
 }
 
+/// Where a node's own events also go (the other nodes, see relay.rs).
+pub type Outbound = Box<dyn Fn(&str, &JobEvent) + Send + Sync>;
+
 /// Per-job broadcast channels.
 #[derive(Default)]
 pub struct Hub {
     channels: Mutex<HashMap<String, broadcast::Sender<JobEvent>>>,
+    outbound: OnceLock<Outbound>,
 }
 
 impl Hub {
@@ -48,8 +52,24 @@ impl Hub {
         let mut m = self.channels.lock().unwrap_or_else(|e| e.into_inner());
         m.entry(id.to_string()).or_insert_with(|| broadcast::channel(256).0).clone()
     }
+    /// An event of a job run here: to this node's listeners and, in a cluster, the others'.
     pub fn publish(&self, id: &str, ev: JobEvent) {
+        if let Some(out) = self.outbound.get() {
+            out(id, &ev);
+        }
+        self.deliver(id, ev);
+    }
+    /// To this node's listeners only (an event relayed from another node).
+    pub fn deliver(&self, id: &str, ev: JobEvent) {
         let _ = self.sender(id).send(ev);
+    }
+    /// Whether anyone here follows the job.
+    pub fn has_listeners(&self, id: &str) -> bool {
+        self.channels.lock().unwrap_or_else(|e| e.into_inner()).get(id).is_some_and(|s| s.receiver_count() > 0)
+    }
+    /// Send every published event also to `out` (set once, when the server starts).
+    pub fn set_outbound(&self, out: Outbound) {
+        let _ = self.outbound.set(out);
     }
     pub fn subscribe(&self, id: &str) -> broadcast::Receiver<JobEvent> {
         self.sender(id).subscribe()

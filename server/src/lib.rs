@@ -1,5 +1,6 @@
-//! fluidbed-server: the HTTP service. Jobs are stored in SQLite under a data directory, run on
-//! worker threads (each on its own rayon pool) and streamed to clients as server-sent events.
+//! fluidbed-server: the HTTP service. Jobs are stored in SQLite under a data directory (or in
+//! PostgreSQL shared by many servers, the nodes of one queue), run on worker threads (each on its
+//! own rayon pool) and streamed to clients as server-sent events.
 //!
 //! ```no_run
 //! let cfg = fluidbed_server::Config::new("data".into());
@@ -9,12 +10,15 @@
 //! ```
 
 pub mod api;
+pub mod cli;
 pub mod events;
 pub mod health;
+pub mod heartbeat;
 pub mod job;
 pub mod listener;
 pub mod metrics;
 pub mod page;
+pub mod relay;
 pub mod store;
 pub mod worker;
 
@@ -29,7 +33,14 @@ use std::time::{Duration, Instant};
 /// How a server is started (the binary's flags).
 #[derive(Clone, Debug)]
 pub struct Config {
+    /// Snapshots, checkpoints, the bed cache and (without `database`) the SQLite job records;
+    /// shared by all nodes of a cluster.
     pub data_dir: PathBuf,
+    /// A `postgres://` URL: job records there, one queue for every server that names it.
+    pub database: Option<String>,
+    /// How long a claimed job stays this node's without a heartbeat; then another node may
+    /// take it over from its last checkpoint.
+    pub lease: Duration,
     /// Address to bind; loopback by default.
     pub listen: SocketAddr,
     /// When set, every route but /healthz needs `Authorization: Bearer <token>`.
@@ -58,6 +69,8 @@ impl Config {
     pub fn new(data_dir: PathBuf) -> Config {
         Config {
             data_dir,
+            database: None,
+            lease: Duration::from_secs(30),
             listen: SocketAddr::from(([127, 0, 0, 1], 8471)),
             token: None,
             workers: 1,
@@ -77,6 +90,8 @@ impl Config {
 /// What handlers and workers share.
 pub struct App {
     pub config: Config,
+    /// This server's name in the job records (the holder of its leases).
+    pub node: String,
     pub store: store::Store,
     pub hub: events::Hub,
     pub queue: worker::Queue,
@@ -129,10 +144,12 @@ pub struct Server {
 }
 
 impl Server {
-    /// Open the store, resume unfinished jobs, start the workers and the HTTP listener.
+    /// Open the store, start the workers (they claim queued jobs and resume unfinished ones),
+    /// the relay of other nodes' events and the HTTP listener.
     pub fn start(config: Config) -> Result<Server> {
-        let store = store::Store::open(&config.data_dir)?;
+        let store = store::Store::open(&config.data_dir, config.database.as_deref())?;
         let app = Arc::new(App {
+            node: job::new_id(),
             store,
             hub: events::Hub::default(),
             queue: worker::Queue::default(),
@@ -144,12 +161,7 @@ impl Server {
             graceful: AtomicBool::new(false),
             config,
         });
-        // Jobs that were running resume from their last checkpoint; queued ones queue again.
-        for status in [job::Status::Running, job::Status::Queued] {
-            for id in app.store.ids_with(status)? {
-                app.queue.push(id);
-            }
-        }
+        relay::start(&app)?;
         let listener =
             std::net::TcpListener::bind(app.config.listen).with_context(|| format!("bind {}", app.config.listen))?;
         listener.set_nonblocking(true)?;
@@ -169,6 +181,7 @@ impl Server {
         };
         runtime.spawn(listener::serve(listener, router, header_timeout, connections, shutdown_rx));
         let workers = worker::spawn(&app, app.config.workers);
+        tracing::info!(node = %app.node, shared = app.store.records().shared(), "node started");
         Ok(Server { addr, app, runtime: Some(runtime), shutdown_tx: Some(shutdown_tx), workers })
     }
 

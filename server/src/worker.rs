@@ -1,6 +1,7 @@
-//! Worker threads: each takes a job from the queue and runs it on its own rayon pool, never on
-//! the async runtime. Between chunks of steps it checks for cancellation, stores snapshots,
-//! writes checkpoints atomically, and publishes progress.
+//! Worker threads: each claims a job from the store's queue (holding its lease, heartbeat.rs)
+//! and runs it on its own rayon pool, never on the async runtime. Between chunks of steps it
+//! checks for cancellation and a lost lease, stores snapshots, writes checkpoints atomically, and
+//! publishes progress.
 
 use crate::events::{snapshot_payload, EventKind, JobEvent};
 use crate::job::{now_rfc3339, SnapshotInfo, Status};
@@ -11,7 +12,6 @@ use fluidbed_core::case::Case;
 use fluidbed_core::dem::solver_pool;
 use fluidbed_core::output::fields;
 use fluidbed_core::sim::{Simulation, StageTimers};
-use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::{Duration, Instant};
@@ -21,28 +21,38 @@ const CHUNK_WALL: Duration = Duration::from_millis(150);
 /// Least wall time between two progress events.
 const PROGRESS_EVERY: Duration = Duration::from_millis(300);
 
-/// The FIFO of job ids waiting for a worker.
+/// Rung when a job is submitted here, so that an idle worker claims it at once (jobs from other
+/// nodes are found by polling).
 #[derive(Default)]
 pub struct Queue {
-    ids: Mutex<VecDeque<String>>,
+    rung: Mutex<bool>,
     ready: Condvar,
 }
 
 impl Queue {
-    pub fn push(&self, id: String) {
-        self.ids.lock().unwrap_or_else(|e| e.into_inner()).push_back(id);
-        self.ready.notify_one();
+    pub fn ring(&self) {
+        *self.rung.lock().unwrap_or_else(|e| e.into_inner()) = true;
+        self.ready.notify_all();
     }
-    /// The next id, or None after `timeout` (so workers can notice a shutdown).
-    fn pop(&self, timeout: Duration) -> Option<String> {
-        let mut q = self.ids.lock().unwrap_or_else(|e| e.into_inner());
-        if q.is_empty() {
-            q = self.ready.wait_timeout(q, timeout).unwrap_or_else(|e| e.into_inner()).0;
+    /// Until rung or `timeout`.
+    fn wait(&self, timeout: Duration) {
+        let mut rung = self.rung.lock().unwrap_or_else(|e| e.into_inner());
+        if !*rung {
+            rung = self.ready.wait_timeout(rung, timeout).unwrap_or_else(|e| e.into_inner()).0;
         }
-        q.pop_front()
+        *rung = false;
     }
     pub fn wake_all(&self) {
-        self.ready.notify_all();
+        self.ring();
+    }
+}
+
+/// How often an idle worker looks for work (another node's submission, an expired lease).
+fn poll_every(app: &App) -> Duration {
+    if app.store.records().shared() {
+        Duration::from_millis(500)
+    } else {
+        Duration::from_millis(200)
     }
 }
 
@@ -55,25 +65,16 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                 .name(format!("fluidbed-worker-{k}"))
                 .spawn(move || {
                     while !app.stopping() {
-                        if let Some(id) = app.queue.pop(Duration::from_millis(200)) {
-                            let _job = tracing::info_span!("job", id = %id).entered();
-                            // A panic in the solver fails its job, not the worker.
-                            let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_job(&app, &id)));
-                            app.metrics.job_stopped(&id);
-                            let error = match outcome {
-                                Ok(Ok(())) => None,
-                                Ok(Err(e)) => {
-                                    // Most likely a write that failed (a full or read-only disk):
-                                    // free the reserve so that the failure itself can be stored.
-                                    app.store.release_reserve();
-                                    app.health.write_failed(&format!("{e:#}"));
-                                    Some(format!("cannot store the job's results: {e:#}"))
-                                }
-                                Err(p) => Some(format!("the solver panicked: {}", panic_text(&*p))),
-                            };
-                            if let Some(msg) = error.filter(|_| !app.stopping()) {
-                                tracing::error!("{msg}");
-                                finish(&app, &id, Status::Failed, Some(&msg));
+                        let lease_s = app.config.lease.as_secs_f64();
+                        match app.store.records().claim(&app.node, lease_s) {
+                            Ok(Some(id)) => {
+                                let _job = tracing::info_span!("job", id = %id).entered();
+                                run_claimed(&app, &id);
+                            }
+                            Ok(None) => app.queue.wait(poll_every(&app)),
+                            Err(e) => {
+                                tracing::warn!("cannot look for queued jobs: {e:#}");
+                                app.queue.wait(Duration::from_secs(1));
                             }
                         }
                     }
@@ -81,6 +82,37 @@ pub fn spawn(app: &Arc<App>, n: usize) -> Vec<std::thread::JoinHandle<()>> {
                 .expect("spawn worker thread")
         })
         .collect()
+}
+
+/// Run a job this node holds the lease of, renewing the lease meanwhile (heartbeat.rs).
+fn run_claimed(app: &Arc<App>, id: &str) {
+    let lost = AtomicBool::new(false);
+    let done = crate::heartbeat::Done::default();
+    std::thread::scope(|s| {
+        s.spawn(|| crate::heartbeat::beat(app, id, &lost, &done));
+        // A panic in the solver fails its job, not the worker.
+        let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| run_job(app, id, &lost)));
+        done.set();
+        app.metrics.job_stopped(id);
+        let error = match outcome {
+            Ok(Ok(())) => None,
+            Ok(Err(e)) => {
+                // Most likely a write that failed (a full or read-only disk): free the reserve
+                // so that the failure itself can be stored.
+                app.store.release_reserve();
+                app.health.write_failed(&format!("{e:#}"));
+                Some(format!("cannot store the job's results: {e:#}"))
+            }
+            Err(p) => Some(format!("the solver panicked: {}", panic_text(&*p))),
+        };
+        if let Some(msg) = error.filter(|_| !app.stopping() && !lost.load(Ordering::SeqCst)) {
+            tracing::error!("{msg}");
+            finish(app, id, Status::Failed, Some(&msg));
+        }
+    });
+    if lost.load(Ordering::SeqCst) {
+        tracing::warn!("lease lost: stopped here, the job goes on where its lease is now");
+    }
 }
 
 fn panic_text(p: &(dyn std::any::Any + Send)) -> String {
@@ -96,7 +128,7 @@ fn finish(app: &App, id: &str, status: Status, message: Option<&str>) {
     if app.stopping() {
         return;
     }
-    let doc = match app.store.finish(id, status, message, &now_rfc3339()) {
+    let doc = match app.store.finish(id, status, message, &now_rfc3339(), Some(&app.node)) {
         Ok(true) => app.store.get(id).ok().flatten().map(|j| j.status_event()),
         Ok(false) => None,
         Err(e) => {
@@ -124,7 +156,7 @@ pub fn cancel_flag(app: &App, id: &str) -> Arc<AtomicBool> {
     app.cancels.lock().unwrap_or_else(|e| e.into_inner()).entry(id.to_string()).or_default().clone()
 }
 
-fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
+fn run_job(app: &Arc<App>, id: &str, lost: &AtomicBool) -> Result<()> {
     let Some(job) = app.store.get(id)? else { return Ok(()) };
     if job.status.is_final() {
         return Ok(());
@@ -146,7 +178,9 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
         );
         return fail(app, id, &msg);
     }
-    app.store.set_running(id, &now_rfc3339())?;
+    if !app.store.set_running(id, &now_rfc3339())? {
+        return Ok(());
+    }
     if let Some(job) = app.store.get(id)? {
         app.hub.publish(id, JobEvent::new(EventKind::Status, None, &job.status_event()));
     }
@@ -156,16 +190,19 @@ fn run_job(app: &Arc<App>, id: &str) -> Result<()> {
     let base_wall = job.wall_s;
     tracing::info!(threads, resumed = job.status == Status::Running, "job started");
     let span = tracing::Span::current();
-    let out = pool.install(|| span.in_scope(|| drive(app, id, &cancel, base_wall)));
-    if app.stopping() && app.graceful() {
-        app.store.release_attempt(id)?;
+    let out = pool.install(|| span.in_scope(|| drive(app, id, &cancel, lost, base_wall)));
+    if app.stopping() && app.graceful() && !lost.load(Ordering::SeqCst) {
+        app.store.records().release(id, &app.node, true)?;
     }
     out
 }
 
 /// Build or restore the simulation and step it to the end, a chunk at a time.
-fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Result<()> {
+fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, lost: &AtomicBool, base_wall: f64) -> Result<()> {
     let prepared_from = Instant::now();
+    let lost = || lost.load(Ordering::SeqCst);
+    // A crash-like stop or a lost lease: write nothing more.
+    let abandon = || lost() || (app.stopping() && !app.graceful());
     let mut sim = match app.store.checkpoint(id)? {
         Some(bytes) => match Simulation::restore(&bytes) {
             Ok(s) => s,
@@ -182,10 +219,10 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             }
             // The pour stops at once on a cancel or a server stop (then Simulation::new finds
             // the poured bed in the cache).
-            let stop = || cancel.load(Ordering::SeqCst) || app.stopping();
+            let stop = || cancel.load(Ordering::SeqCst) || app.stopping() || lost();
             let cache = app.store.cache_dir();
             if let Err(e) = fluidbed_core::dem::build_bed_until(&case, Some(&cache), &stop) {
-                return if app.stopping() {
+                return if app.stopping() || lost() {
                     Ok(())
                 } else if cancel.load(Ordering::SeqCst) {
                     finish(app, id, Status::Cancelled, Some("cancelled by request while preparing the bed"));
@@ -204,7 +241,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             sim
         }
     };
-    if app.stopping() {
+    if app.stopping() || lost() {
         return Ok(());
     }
     if cancel.load(Ordering::SeqCst) {
@@ -221,6 +258,9 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
     let mut last_progress = Instant::now() - PROGRESS_EVERY;
     let wall_before = base_wall + prepared_from.elapsed().as_secs_f64();
     while !sim.is_finished() {
+        if lost() {
+            return Ok(());
+        }
         if app.stopping() {
             return stop_here(app, id, &sim);
         }
@@ -239,7 +279,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
         };
         // A crash-like stop writes nothing more; a graceful one stores this chunk's snapshot and
         // checkpoints at the top of the loop.
-        if app.stopping() && !app.graceful() {
+        if abandon() {
             return Ok(());
         }
         let wall = wall_before + started.elapsed().as_secs_f64();
@@ -255,7 +295,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, base_wall: f64) -> Resul
             };
             app.metrics.snapshot_written(app.store.put_snapshot(id, &s, &info)?);
             if sim.time() - last_checkpoint_t >= checkpoint_every || sim.is_finished() {
-                if app.stopping() && !app.graceful() {
+                if abandon() {
                     return Ok(());
                 }
                 put_checkpoint(app, id, &sim)?;

@@ -130,7 +130,7 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
     if let Err(e) = app.store.insert(&job, &case_json) {
         return internal(e);
     }
-    app.queue.push(job.id.clone());
+    app.queue.ring();
     let location = format!("/v1/jobs/{}", job.id);
     (StatusCode::CREATED, [(header::LOCATION, location)], Json(job.to_api())).into_response()
 }
@@ -259,8 +259,7 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
     }
     cancel_flag(&app, &id).store(true, Ordering::SeqCst);
     if job.status == Status::Queued {
-        if let Ok(true) = app.store.finish(&id, Status::Cancelled, Some("cancelled before it started"), &now_rfc3339())
-        {
+        if let Ok(true) = app.store.records().cancel_queued(&id, "cancelled before it started", &now_rfc3339()) {
             if let Ok(Some(j)) = app.store.get(&id) {
                 app.hub.publish(&id, JobEvent::new(EventKind::Status, None, &j.status_event()));
                 app.hub.publish(&id, JobEvent::new(EventKind::End, None, &j.status_event()));

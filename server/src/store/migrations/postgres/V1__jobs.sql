@@ -1,0 +1,30 @@
+CREATE TABLE IF NOT EXISTS jobs (
+  seq BIGSERIAL PRIMARY KEY,
+  id TEXT UNIQUE NOT NULL,
+  name TEXT NOT NULL,
+  status TEXT NOT NULL,
+  case_json TEXT NOT NULL,
+  created_at TEXT NOT NULL,
+  started_at TEXT,
+  finished_at TEXT,
+  time_s DOUBLE PRECISION NOT NULL DEFAULT 0,
+  end_time_s DOUBLE PRECISION NOT NULL,
+  steps BIGINT NOT NULL DEFAULT 0,
+  wall_s DOUBLE PRECISION NOT NULL DEFAULT 0,
+  eta_s DOUBLE PRECISION,
+  message TEXT,
+  warnings TEXT NOT NULL,
+  plan TEXT,
+  cancel_requested BOOLEAN NOT NULL DEFAULT FALSE,
+  attempts INTEGER NOT NULL DEFAULT 0
+);
+CREATE INDEX IF NOT EXISTS jobs_status ON jobs(status);
+CREATE TABLE IF NOT EXISTS snapshots (
+  job_id TEXT NOT NULL,
+  n BIGINT NOT NULL,
+  time_s DOUBLE PRECISION NOT NULL,
+  step BIGINT NOT NULL,
+  pressure_drop_pa DOUBLE PRECISION,
+  mean_particle_height_m DOUBLE PRECISION,
+  PRIMARY KEY (job_id, n)
+);

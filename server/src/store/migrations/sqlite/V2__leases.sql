@@ -1,0 +1,3 @@
+-- The node running a job and until when (Unix seconds) its lease holds.
+ALTER TABLE jobs ADD COLUMN owner TEXT;
+ALTER TABLE jobs ADD COLUMN lease_until REAL;
