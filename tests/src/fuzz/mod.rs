@@ -156,9 +156,8 @@ pub async fn run(n: usize, seed: u64) -> Report {
             Ok(r) => r,
             // A body over the limit is answered 413 while it is still being sent; the client
             // may see only the closed connection.
-            Err(e) if len > MAX_BODY => {
+            Err(_) if len > MAX_BODY => {
                 report.cut_off_oversize += 1;
-                let _ = e;
                 continue;
             }
             Err(e) => {
