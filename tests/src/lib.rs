@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 
 pub use fluidbed::watch::{parse_events, SseEvent};
 
+pub mod fuzz;
 pub mod postgres;
 pub mod webdriver;
 

@@ -91,6 +91,10 @@ fn json_num(x: f64) -> Value {
     serde_json::Number::from_f64(x).map(Value::Number).unwrap_or(Value::String(format!("{x}")))
 }
 
+/// Particles outside the column listed one by one; the rest are counted in one problem (a
+/// 16-MiB bed of a million stray particles would otherwise answer with a million errors).
+const MAX_LISTED_POSITIONS: usize = 20;
+
 /// Top-level sections a case must state; everything else has the paper's defaults.
 const REQUIRED: [&str; 3] = ["column", "particles", "bed"];
 
@@ -120,10 +124,14 @@ impl Case {
         if !report.is_ok() {
             return Err(report);
         }
-        let case: Case = match serde_json::from_value(v.clone()) {
+        // What a section alone accepts and the case does not (a null `end_time_s` or `name`:
+        // optional in `PartialCase`, not in `Case`) is named by its pointer too.
+        let case: Case = match serde_path_to_error::deserialize(v.clone()) {
             Ok(c) => c,
             Err(e) => {
-                report.error("", Value::Null, "see the case schema", e.to_string());
+                let path = pointer_of(e.path());
+                let value = pointer_value(v, &path);
+                report.error(&path, value, "see the case schema (GET /v1/schema/case)", e.inner().to_string());
                 return Err(report);
             }
         };
@@ -327,6 +335,7 @@ impl Case {
                 if e.positions_m.is_empty() {
                     r.error("/bed/explicit/positions_m", 0, "at least one particle", "no particles");
                 }
+                let mut outside = 0usize;
                 for (i, x) in e.positions_m.iter().enumerate() {
                     let rr = (x[0] * x[0] + x[1] * x[1]).sqrt();
                     if !(rr <= rad - d / 2.0 + 1e-12
@@ -334,6 +343,10 @@ impl Case {
                         && x[2] <= h
                         && x.iter().all(|v| v.is_finite()))
                     {
+                        outside += 1;
+                        if outside > MAX_LISTED_POSITIONS {
+                            continue;
+                        }
                         r.error(
                             &format!("/bed/explicit/positions_m/{i}"),
                             serde_json::to_value(x).unwrap_or(Value::Null),
@@ -341,6 +354,14 @@ impl Case {
                             "particle outside the column",
                         );
                     }
+                }
+                if outside > MAX_LISTED_POSITIONS {
+                    r.error(
+                        "/bed/explicit/positions_m",
+                        outside,
+                        format!("r <= {} m, {} m <= z <= {} m", rad - d / 2.0, d / 2.0, h),
+                        format!("{outside} particles outside the column (the first {MAX_LISTED_POSITIONS} listed)"),
+                    );
                 }
                 if let Some(v) = &e.velocities_m_s {
                     if v.len() != e.positions_m.len() {
@@ -498,7 +519,9 @@ fn pointer_of(p: &serde_path_to_error::Path) -> String {
     for seg in p.iter() {
         match seg {
             Segment::Seq { index } => out.push_str(&format!("/{index}")),
-            Segment::Map { key } | Segment::Enum { variant: key } => out.push_str(&format!("/{key}")),
+            Segment::Map { key } | Segment::Enum { variant: key } => {
+                out.push_str(&format!("/{}", key.replace('~', "~0").replace('/', "~1")))
+            }
             Segment::Unknown => {}
         }
     }

@@ -43,13 +43,19 @@ pub fn cell_stable_dt(
 }
 
 /// The stable gas step a case's inlet flow allows before it runs: gas at the outlet density,
-/// speed U/ε_inlet in every direction. `None` when the grid or gas parameters are unusable
-/// (validation reports those separately).
+/// speed U/ε_inlet in every direction. `None` when the grid or gas parameters are unusable or
+/// the grid is beyond `case::bounds::MAX_CELLS` (validation reports those separately).
 pub fn case_stable_time_step(case: &Case) -> Option<f64> {
     let g = case.gas.as_ref()?;
     let (radius, dr, dz, n0) = (case.column.diameter_m / 2.0, case.grid.dr_m, case.grid_dz_m(), case.grid.n0);
     let ok = |x: f64| x.is_finite() && x > 0.0;
-    if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && radius / dr < 1e4 && (1..=64).contains(&n0)) {
+    if !(ok(radius) && ok(dr) && ok(dz) && dr <= radius && (1..=64).contains(&n0)) {
+        return None;
+    }
+    // The face geometry below is allocated per cell of a layer: a grid beyond the case bounds
+    // (refused by `validate`) must not be built here first (issue 22: 1e4 annuli of 64 cells
+    // asked for ~50 GB).
+    if n0 as f64 * (radius / dr).round().powi(2) > crate::case::bounds::MAX_CELLS {
         return None;
     }
     let (a, rho) = (g.acoustic_speed_m_s(), g.outlet_density_kg_m3());

@@ -39,18 +39,24 @@ use std::time::Duration;
             headers(("Location" = String, description = "/v1/jobs/{id}"))),
         (status = 400, description = "Not JSON", body = fluidbed_api::Problem, content_type = "application/problem+json"),
         (status = 413, description = "Over --max-body-bytes", body = fluidbed_api::Problem, content_type = "application/problem+json"),
+        (status = 415, description = "A Content-Type other than JSON", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
         (status = 422, description = "Invalid case: `errors` names every field", body = fluidbed_api::Problem,
             content_type = "application/problem+json"),
         (status = 429, description = "Too many submissions or a full queue", body = fluidbed_api::Problem,
             content_type = "application/problem+json", headers(("Retry-After" = String, description = "seconds"))),
     )
 )]
-pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesRejection>) -> Response {
+pub async fn create(State(app): State<Arc<App>>, headers: HeaderMap, body: Result<Bytes, BytesRejection>) -> Response {
     let body = match body {
         Ok(b) => b,
         Err(e) if e.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+            // The rest of the body is not read, so the connection cannot carry another request:
+            // without `close` a client reuses it and its next request is lost (issue 22's fuzz).
             let d = format!("a case may be at most {} bytes", app.config.max_body_bytes);
-            return problem(StatusCode::PAYLOAD_TOO_LARGE, "Request body too large", &d);
+            let mut r = problem(StatusCode::PAYLOAD_TOO_LARGE, "Request body too large", &d);
+            r.headers_mut().insert(header::CONNECTION, header::HeaderValue::from_static("close"));
+            return r;
         }
         Err(e) => {
             // A body that stalled or broke off: answer and close (the rest is not waited for).
@@ -59,6 +65,14 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
             return r;
         }
     };
+    // A body sent as something else (a form, text) is not read as a case; no header is JSON.
+    // (After the body is read whole: an answer before that must close the connection.)
+    if let Some(ct) = headers.get(header::CONTENT_TYPE) {
+        if !ct.to_str().is_ok_and(is_json_media_type) {
+            let d = format!("a case is sent as application/json (got {:?})", String::from_utf8_lossy(ct.as_bytes()));
+            return problem(StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type", &d);
+        }
+    }
     if !app.take_submission_token() {
         let mut r = problem(
             StatusCode::TOO_MANY_REQUESTS,
@@ -133,6 +147,12 @@ pub async fn create(State(app): State<Arc<App>>, body: Result<Bytes, BytesReject
     app.queue.ring();
     let location = format!("/v1/jobs/{}", job.id);
     (StatusCode::CREATED, [(header::LOCATION, location)], Json(job.to_api())).into_response()
+}
+
+/// `application/json` or `application/*+json`, with any parameters, in any case.
+fn is_json_media_type(ct: &str) -> bool {
+    let t = ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase();
+    t == "application/json" || (t.starts_with("application/") && t.ends_with("+json"))
 }
 
 /// 422 with every problem named by its JSON pointer.
