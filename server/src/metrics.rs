@@ -121,6 +121,8 @@ pub fn route_of(path: &str) -> &'static str {
         ["v1", "jobs", _, "snapshots"] => "/v1/jobs/{id}/snapshots",
         ["v1", "jobs", _, "snapshots", _] => "/v1/jobs/{id}/snapshots/{n}",
         ["v1", "jobs", _, "pressure-drop"] => "/v1/jobs/{id}/pressure-drop",
+        ["v1", "jobs", _, "analysis"] => "/v1/jobs/{id}/analysis",
+        ["v1", "jobs", _, "analysis", _] => "/v1/jobs/{id}/analysis/{figure}",
         ["jobs", _] => "/jobs/{id}",
         ["ui", "cases.json"] => "/ui/cases.json",
         ["ui", _] => "/ui/{file}",

@@ -144,6 +144,10 @@ pub fn axial_slice(grid: &CylGrid, field: &[f64], labels: &FieldLabels) -> Resul
                 let Some((x_mm, z_mm)) = spec.reverse_translate((px, py)) else { continue };
                 // A hair off the plane so that points on a cell boundary pick one side consistently.
                 let v = field[grid.locate(1e-3 * x_mm, 1e-9 * grid.radius, 1e-3 * z_mm)];
+                // A cell without a value (NaN: e.g. never visited by a particle) stays white.
+                if v.is_nan() {
+                    continue;
+                }
                 let c = rgb(colour((v - lo) / (hi - lo)));
                 pixels.draw_pixel((px - xs.start, py - ys.start), &c).map_err(fail)?;
             }
