@@ -26,6 +26,9 @@ use std::path::{Path, PathBuf};
 pub struct Store {
     dir: PathBuf,
     records: Box<dyn Records>,
+    /// Size of the largest snapshot or checkpoint write that failed since the last healthy probe
+    /// (health.rs probes with that many bytes, so a disk with room for less stays degraded).
+    failed_write_bytes: std::sync::atomic::AtomicU64,
 }
 
 /// Bytes kept in DIR/reserve.bin: freed when a write fails, so that the database can still mark the job.
@@ -52,7 +55,7 @@ impl Store {
                 other.split('@').next_back().unwrap_or(other)
             ),
         };
-        let store = Store { dir: dir.to_path_buf(), records };
+        let store = Store { dir: dir.to_path_buf(), records, failed_write_bytes: Default::default() };
         store.restore_reserve();
         Ok(store)
     }
@@ -80,6 +83,20 @@ impl Store {
     /// Free the reserve (after a failed write), so that the failure itself can be recorded.
     pub fn release_reserve(&self) {
         let _ = std::fs::remove_file(self.reserve_path());
+    }
+    /// The largest result write that failed since `forget_failed_writes` (0: none).
+    pub fn failed_write_bytes(&self) -> u64 {
+        self.failed_write_bytes.load(std::sync::atomic::Ordering::SeqCst)
+    }
+    pub fn forget_failed_writes(&self) {
+        self.failed_write_bytes.store(0, std::sync::atomic::Ordering::SeqCst);
+    }
+    /// `write_atomic`, remembering the size of a write that failed.
+    fn put_file(&self, path: &Path, bytes: &[u8]) -> Result<()> {
+        write_atomic(path, bytes).map_err(|e| {
+            self.failed_write_bytes.fetch_max(bytes.len() as u64, std::sync::atomic::Ordering::SeqCst);
+            anyhow::Error::new(e).context(format!("cannot write {}", path.display()))
+        })
     }
     pub fn reserve_held(&self) -> bool {
         std::fs::metadata(self.reserve_path()).is_ok_and(|m| m.len() as usize == RESERVE_BYTES)
@@ -163,7 +180,7 @@ impl Store {
     pub fn put_snapshot(&self, id: &str, s: &Snapshot, info: &SnapshotInfo) -> Result<u64> {
         let path = self.snapshot_path(id, s.index);
         let bytes = bincode::serialize(s)?;
-        write_atomic(&path, &bytes).with_context(|| format!("cannot write {}", path.display()))?;
+        self.put_file(&path, &bytes)?;
         self.records.put_snapshot_info(id, info)?;
         Ok(bytes.len() as u64)
     }
@@ -182,8 +199,7 @@ impl Store {
     }
 
     pub fn put_checkpoint(&self, id: &str, bytes: &[u8]) -> Result<()> {
-        let path = self.checkpoint_path(id);
-        write_atomic(&path, bytes).with_context(|| format!("cannot write {}", path.display()))
+        self.put_file(&self.checkpoint_path(id), bytes)
     }
 
     pub fn checkpoint(&self, id: &str) -> Result<Option<Vec<u8>>> {
