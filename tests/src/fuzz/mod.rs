@@ -59,8 +59,9 @@ pub fn shipped_cases() -> Vec<Value> {
 /// The servers' body limit (`test_config`: 256 KiB).
 const MAX_BODY: usize = 256 * 1024;
 
-/// An answer slower than this is a failure: validation must not hang on any body.
-pub const SLOW_MS: f64 = 10_000.0;
+/// A request unanswered after this long is a hang (its timeout, a transport error): validation
+/// must not hang on any body. Not a speed bound: the slowest answer is reported, not judged.
+pub const HANG_TIMEOUT: std::time::Duration = std::time::Duration::from_secs(60);
 
 /// What a fuzz run found.
 #[derive(Debug, Default)]
@@ -76,7 +77,7 @@ pub struct Report {
     pub accepted: usize,
     /// Bodies over the limit whose 413 the client missed while still sending (not a failure).
     pub cut_off_oversize: usize,
-    /// The slowest answer, ms (answers over `SLOW_MS` are counted in `unexpected`).
+    /// The slowest answer, ms (reported only; a request past `HANG_TIMEOUT` is a transport error).
     pub slowest_ms: f64,
     pub by_status: BTreeMap<u16, usize>,
     /// The 10^8-particle case was refused with 422 naming /bed/generated/count.
@@ -147,7 +148,7 @@ pub async fn run(n: usize, seed: u64) -> Report {
         let s = mutate::submission(&bases, seed, i as u64);
         report.cases += 1;
         let len = s.body.len();
-        let mut req = http.post(&jobs).body(s.body);
+        let mut req = http.post(&jobs).timeout(HANG_TIMEOUT).body(s.body);
         if let Some(ct) = s.content_type {
             req = req.header("content-type", ct);
         }
@@ -180,10 +181,6 @@ pub async fn run(n: usize, seed: u64) -> Report {
         let body = r.bytes().await.unwrap_or_default();
         let ms = sent.elapsed().as_secs_f64() * 1e3;
         report.slowest_ms = report.slowest_ms.max(ms);
-        if ms > SLOW_MS {
-            report.unexpected += 1;
-            report.fail(&s.label, format!("answered in {ms:.0} ms"));
-        }
         match judge::judge(s.content_type, status, ct.as_deref(), &body, s.value.as_ref()) {
             Verdict::Fine => {}
             Verdict::ServerError(w) => {
