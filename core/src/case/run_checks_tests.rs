@@ -115,3 +115,14 @@ fn soft_particles_at_the_largest_impact_speed_warn_of_a_deep_overlap() {
     c.particles.youngs_modulus_pa = e;
     assert!((c.impact_overlap_fraction(c.largest_impact_speed_m_s()) - 0.1).abs() < 1e-3);
 }
+
+#[test]
+fn an_explicit_bed_far_outside_the_column_is_refused_without_overflow() {
+    // Positions at ±1e300 m once overflowed the overlap check's cell keys (found by the OpenAPI fuzz).
+    let c = case(
+        r#"{"column":{"diameter_m":0.044,"height_m":0.12},"particles":{},
+            "bed":{"explicit":{"positions_m":[[1e300,0,0.01],[1e300,0,0.01],[-1e300,1e300,1e300]]}}}"#,
+    );
+    let rep = c.validate();
+    assert!(paths(&rep.errors).iter().any(|p| p.starts_with("/bed/explicit/positions_m")), "{:?}", rep.errors);
+}
