@@ -118,7 +118,7 @@ fn soft_particles_at_the_largest_impact_speed_warn_of_a_deep_overlap() {
 
 #[test]
 fn an_explicit_bed_far_outside_the_column_is_refused_without_overflow() {
-    // Positions at ±1e300 m once overflowed the overlap check's cell keys (found by the OpenAPI fuzz).
+    // Coordinates of ±1e300 m: the overlap check must not overflow its i64 cell keys.
     let c = case(
         r#"{"column":{"diameter_m":0.044,"height_m":0.12},"particles":{},
             "bed":{"explicit":{"positions_m":[[1e300,0,0.01],[1e300,0,0.01],[-1e300,1e300,1e300]]}}}"#,
