@@ -10,13 +10,17 @@ pub mod job;
 pub mod problem;
 pub mod query;
 pub mod snapshot;
+pub mod sweep;
 
 pub use events::{ProgressEvent, SnapshotEvent, StatusEvent};
 pub use health::{DataDirReport, Health, HealthStatus};
 pub use job::{CaseProblem, Job, JobLinks, JobList, JobStatus, Severity};
 pub use problem::{FieldError, Problem};
-pub use query::{EventsQuery, ListQuery, SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery};
+pub use query::{
+    EventsQuery, ListQuery, PageQuery, SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery,
+};
 pub use snapshot::{Binary, GridInfo, ParticleState, PressureDropSeries, SnapshotDocument, SnapshotInfo, SnapshotList};
+pub use sweep::{GridAxis, PointSummary, Sweep, SweepList, SweepPoint, SweepRequest};
 
 /// The name of the bearer-token security scheme in the OpenAPI document.
 pub const BEARER: &str = "bearer";

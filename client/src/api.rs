@@ -2,7 +2,7 @@
 //! types, the same ones the server serves.
 
 use anyhow::{anyhow, Result};
-use fluidbed_api::{Job, JobList, ListQuery, Problem, SnapshotList};
+use fluidbed_api::{Job, JobList, ListQuery, Problem, SnapshotList, Sweep, SweepRequest};
 use reqwest::{header, Client, StatusCode};
 use serde::de::DeserializeOwned;
 use serde::Serialize;
@@ -107,6 +107,15 @@ impl Api {
             .send()
             .await;
         Self::json(Self::check(r).await?).await
+    }
+
+    /// Submit a sweep (one job per point).
+    pub async fn submit_sweep(&self, req: &SweepRequest) -> Result<Sweep, ApiError> {
+        Self::json(Self::check(self.http.post(self.url("/v1/sweeps")).json(req).send().await).await?).await
+    }
+
+    pub async fn sweep(&self, id: &str) -> Result<Sweep, ApiError> {
+        self.get(&format!("/v1/sweeps/{id}"), NO_QUERY).await
     }
 
     pub async fn cancel(&self, id: &str) -> Result<Job, ApiError> {

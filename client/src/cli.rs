@@ -67,6 +67,24 @@ enum Verb {
     },
     /// Cancel a job.
     Cancel { id: String },
+    /// Run a base case over a grid of values, one job per point, and print a summary table
+    /// (ΔP mean and deviation, bed height) when every point has ended; with no --server, on an
+    /// embedded server running one point per core.
+    Sweep {
+        base: PathBuf,
+        /// POINTER=FROM:TO:STEP, POINTER=V1,V2,… or POINTER=V; repeat for a grid of every combination.
+        #[arg(long = "set", required = true, value_name = "POINTER=VALUES")]
+        set: Vec<String>,
+        /// The sweep's name (default: the base case's).
+        #[arg(long)]
+        name: Option<String>,
+        /// Output folder (default ./fluidbed-out/<case file name>-sweep/).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Threads per point on the embedded server (default 1, one point per core).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
     /// Submit, watch and fetch; with no --server, on an embedded server.
     Run {
         case: PathBuf,
@@ -263,6 +281,10 @@ async fn dispatch(cli: Cli) -> i32 {
             }
             Err(e) => api_fail(e, j),
         },
+        Verb::Sweep { base, set, name, out, threads } => {
+            let args = crate::cli_sweep::SweepArgs { base, set, name, out, threads };
+            crate::cli_sweep::sweep(cli.server.is_some().then_some(api), token, args, j).await
+        }
         Verb::Run { case, out, formats, threads } => {
             crate::cli_run::run(cli.server.is_some().then_some(api), token, case, out, formats, threads, j).await
         }

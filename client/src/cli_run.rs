@@ -33,7 +33,7 @@ pub async fn run(
     }
     let (api, embedded) = match server {
         Some(api) => (api, None),
-        None => match start_embedded(&out, threads, token.as_deref()) {
+        None => match start_embedded(&out, Embedding::one_job(threads), token.as_deref()) {
             Ok(pair) => pair,
             Err(code) => return code,
         },
@@ -56,7 +56,7 @@ const RUN_MARKER: &str = ".fluidbed-run";
 
 /// Make `out` an empty folder for this run's results: a previous run's folder is replaced (no
 /// stale files beside new ones); any other non-empty folder is refused.
-fn fresh_out(out: &std::path::Path) -> Result<(), String> {
+pub(crate) fn fresh_out(out: &std::path::Path) -> Result<(), String> {
     let entries = match std::fs::read_dir(out) {
         Ok(rd) => rd.count(),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => 0,
@@ -107,14 +107,38 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
 }
 
 #[cfg(feature = "embedded")]
-type Embedded = fluidbed_server::Server;
+pub(crate) type Embedded = fluidbed_server::Server;
 #[cfg(not(feature = "embedded"))]
-type Embedded = ();
+pub(crate) type Embedded = ();
+
+/// How the embedded server runs its jobs.
+pub(crate) struct Embedding {
+    pub workers: usize,
+    pub threads_per_job: usize,
+    pub max_queued: usize,
+}
+
+fn cores() -> usize {
+    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+}
+
+impl Embedding {
+    /// One job on every core (or `threads`).
+    pub fn one_job(threads: Option<usize>) -> Embedding {
+        Embedding { workers: 1, threads_per_job: threads.unwrap_or_else(cores), max_queued: 64 }
+    }
+    /// Independent points: one job per core, one thread each (`threads` each if given), and a
+    /// queue long enough for the sweep.
+    pub fn many_jobs(threads: Option<usize>, points: usize) -> Embedding {
+        let threads_per_job = threads.unwrap_or(1).max(1);
+        Embedding { workers: (cores() / threads_per_job).max(1), threads_per_job, max_queued: points.max(64) }
+    }
+}
 
 #[cfg(feature = "embedded")]
-fn start_embedded(
+pub(crate) fn start_embedded(
     out: &std::path::Path,
-    threads: Option<usize>,
+    how: Embedding,
     token: Option<&str>,
 ) -> Result<(Api, Option<Embedded>), i32> {
     let data = out.join("server-data");
@@ -124,7 +148,9 @@ fn start_embedded(
     }
     let mut cfg = fluidbed_server::Config::new(data);
     cfg.listen = std::net::SocketAddr::from(([127, 0, 0, 1], 0));
-    cfg.threads_per_job = threads.unwrap_or_else(|| std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1));
+    cfg.workers = how.workers;
+    cfg.threads_per_job = how.threads_per_job;
+    cfg.max_queued = how.max_queued;
     cfg.token = token.map(str::to_string);
     let server = fluidbed_server::Server::start(cfg)
         .map_err(|e| fail(exit::SERVER, &format!("cannot start the embedded server: {e:#}")))?;
@@ -133,9 +159,9 @@ fn start_embedded(
 }
 
 #[cfg(not(feature = "embedded"))]
-fn start_embedded(
+pub(crate) fn start_embedded(
     _out: &std::path::Path,
-    _threads: Option<usize>,
+    _how: Embedding,
     _token: Option<&str>,
 ) -> Result<(Api, Option<Embedded>), i32> {
     Err(fail(exit::USAGE, "this build has no embedded server (feature `embedded`): pass --server URL"))

@@ -5,6 +5,7 @@
 pub mod api;
 pub mod cli;
 mod cli_run;
+mod cli_sweep;
 pub mod fetch;
 mod outcome;
 mod validate;

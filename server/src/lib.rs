@@ -20,6 +20,7 @@ pub mod metrics;
 pub mod page;
 pub mod relay;
 pub mod store;
+pub mod sweep;
 pub mod worker;
 
 use anyhow::{Context, Result};

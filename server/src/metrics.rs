@@ -123,6 +123,8 @@ pub fn route_of(path: &str) -> &'static str {
         ["v1", "jobs", _, "pressure-drop"] => "/v1/jobs/{id}/pressure-drop",
         ["v1", "jobs", _, "analysis"] => "/v1/jobs/{id}/analysis",
         ["v1", "jobs", _, "analysis", _] => "/v1/jobs/{id}/analysis/{figure}",
+        ["v1", "sweeps"] => "/v1/sweeps",
+        ["v1", "sweeps", _] => "/v1/sweeps/{id}",
         ["jobs", _] => "/jobs/{id}",
         ["ui", "cases.json"] => "/ui/cases.json",
         ["ui", _] => "/ui/{file}",

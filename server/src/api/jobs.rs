@@ -48,58 +48,9 @@ use std::time::Duration;
     )
 )]
 pub async fn create(State(app): State<Arc<App>>, headers: HeaderMap, body: Result<Bytes, BytesRejection>) -> Response {
-    let body = match body {
-        Ok(b) => b,
-        Err(e) if e.status() == StatusCode::PAYLOAD_TOO_LARGE => {
-            // The rest of the body is not read, so the connection cannot carry another request:
-            // without `close` a client reuses it and its next request is lost (issue 22's fuzz).
-            let d = format!("a case may be at most {} bytes", app.config.max_body_bytes);
-            let mut r = problem(StatusCode::PAYLOAD_TOO_LARGE, "Request body too large", &d);
-            r.headers_mut().insert(header::CONNECTION, header::HeaderValue::from_static("close"));
-            return r;
-        }
-        Err(e) => {
-            // A body that stalled or broke off: answer and close (the rest is not waited for).
-            let mut r = problem(e.status(), "Unreadable request body", &e.body_text());
-            r.headers_mut().insert(header::CONNECTION, header::HeaderValue::from_static("close"));
-            return r;
-        }
-    };
-    // A body sent as something else (a form, text) is not read as a case; no header is JSON.
-    // (After the body is read whole: an answer before that must close the connection.)
-    if let Some(ct) = headers.get(header::CONTENT_TYPE) {
-        if !ct.to_str().is_ok_and(is_json_media_type) {
-            let d = format!("a case is sent as application/json (got {:?})", String::from_utf8_lossy(ct.as_bytes()));
-            return problem(StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type", &d);
-        }
-    }
-    if !app.take_submission_token() {
-        let mut r = problem(
-            StatusCode::TOO_MANY_REQUESTS,
-            "Too many submissions",
-            "slow down: the server accepts a few jobs per second",
-        );
-        r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("1"));
-        return r;
-    }
-    let Ok(text) = std::str::from_utf8(&body) else {
-        return problem(StatusCode::BAD_REQUEST, "Malformed JSON", "the body is not UTF-8 text");
-    };
-    let value = match strict_json::parse(text) {
+    let value = match read_json(&app, &headers, body) {
         Ok(v) => v,
-        Err(StrictJsonError::Syntax(e)) => {
-            return problem(StatusCode::BAD_REQUEST, "Malformed JSON", &format!("the body is not valid JSON: {e}"))
-        }
-        Err(StrictJsonError::DuplicateKey { pointer, message }) => {
-            let p = Problem {
-                path: pointer,
-                value: Value::Null,
-                allowed: "each key once".into(),
-                message,
-                severity: Severity::Error,
-            };
-            return invalid_case(&[p], &[]);
-        }
+        Err(r) => return r,
     };
     let (case, report) = match Case::parse_value(&value) {
         Ok(ok) => ok,
@@ -109,34 +60,10 @@ pub async fn create(State(app): State<Arc<App>>, headers: HeaderMap, body: Resul
     if let Some(p) = CaseSize::of(&case).memory_problem(&case, app.config.max_job_memory) {
         return invalid_case(&[p], &report.warnings);
     }
-    match app.store.count(Status::Queued) {
-        Ok(n) if n >= app.config.max_queued => {
-            let d = format!("{n} jobs are already waiting; try again later");
-            let mut r = problem(StatusCode::TOO_MANY_REQUESTS, "Queue full", &d);
-            r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("30"));
-            return r;
-        }
-        Ok(_) => {}
-        Err(e) => return internal(e),
+    if let Err(r) = queue_room(&app, 1) {
+        return r;
     }
-    let job = Job {
-        id: new_id(),
-        name: case.name.clone(),
-        status: Status::Queued,
-        created_at: now_rfc3339(),
-        started_at: None,
-        finished_at: None,
-        time_s: 0.0,
-        end_time_s: case.end_time_s,
-        steps: 0,
-        wall_s: 0.0,
-        eta_s: None,
-        message: None,
-        warnings: case_problems(&report.warnings),
-        plan: None,
-        cancel_requested: false,
-        attempts: 0,
-    };
+    let job = new_job(&case, &report.warnings);
     let case_json = match serde_json::to_string(&case) {
         Ok(s) => s,
         Err(e) => return internal(e.into()),
@@ -149,6 +76,114 @@ pub async fn create(State(app): State<Arc<App>>, headers: HeaderMap, body: Resul
     (StatusCode::CREATED, [(header::LOCATION, location)], Json(job.to_api())).into_response()
 }
 
+/// The request body as JSON, or the answer to send instead: too large (413), stalled, not JSON
+/// by its Content-Type (415), over the submission rate (429), not UTF-8 or not JSON (400), a key
+/// given twice (422).
+#[allow(clippy::result_large_err)]
+pub(super) fn read_json(
+    app: &App,
+    headers: &HeaderMap,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Value, Response> {
+    let body = match body {
+        Ok(b) => b,
+        Err(e) if e.status() == StatusCode::PAYLOAD_TOO_LARGE => {
+            // The rest of the body is not read, so the connection cannot carry another request:
+            // without `close` a client reuses it and its next request is lost (issue 22's fuzz).
+            let d = format!("a request body may be at most {} bytes", app.config.max_body_bytes);
+            let mut r = problem(StatusCode::PAYLOAD_TOO_LARGE, "Request body too large", &d);
+            r.headers_mut().insert(header::CONNECTION, header::HeaderValue::from_static("close"));
+            return Err(r);
+        }
+        Err(e) => {
+            // A body that stalled or broke off: answer and close (the rest is not waited for).
+            let mut r = problem(e.status(), "Unreadable request body", &e.body_text());
+            r.headers_mut().insert(header::CONNECTION, header::HeaderValue::from_static("close"));
+            return Err(r);
+        }
+    };
+    // A body sent as something else (a form, text) is not read as JSON; no header is JSON.
+    // (After the body is read whole: an answer before that must close the connection.)
+    if let Some(ct) = headers.get(header::CONTENT_TYPE) {
+        if !ct.to_str().is_ok_and(is_json_media_type) {
+            let d = format!("the body is sent as application/json (got {:?})", String::from_utf8_lossy(ct.as_bytes()));
+            return Err(problem(StatusCode::UNSUPPORTED_MEDIA_TYPE, "Unsupported media type", &d));
+        }
+    }
+    if !app.take_submission_token() {
+        let mut r = problem(
+            StatusCode::TOO_MANY_REQUESTS,
+            "Too many submissions",
+            "slow down: the server accepts a few submissions per second",
+        );
+        r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("1"));
+        return Err(r);
+    }
+    let Ok(text) = std::str::from_utf8(&body) else {
+        return Err(problem(StatusCode::BAD_REQUEST, "Malformed JSON", "the body is not UTF-8 text"));
+    };
+    match strict_json::parse(text) {
+        Ok(v) => Ok(v),
+        Err(StrictJsonError::Syntax(e)) => {
+            Err(problem(StatusCode::BAD_REQUEST, "Malformed JSON", &format!("the body is not valid JSON: {e}")))
+        }
+        Err(StrictJsonError::DuplicateKey { pointer, message }) => {
+            let p = Problem {
+                path: pointer,
+                value: Value::Null,
+                allowed: "each key once".into(),
+                message,
+                severity: Severity::Error,
+            };
+            Err(invalid_case(&[p], &[]))
+        }
+    }
+}
+
+/// Room in the queue for `n` more jobs, or 429 with the count waiting.
+#[allow(clippy::result_large_err)]
+pub(super) fn queue_room(app: &App, n: usize) -> Result<(), Response> {
+    match app.store.count(Status::Queued) {
+        Ok(waiting) if waiting + n > app.config.max_queued => {
+            let d = if n == 1 {
+                format!("{waiting} jobs are already waiting; try again later")
+            } else {
+                format!(
+                    "{waiting} jobs are already waiting and the queue holds {}: {n} more do not fit; try again later",
+                    app.config.max_queued
+                )
+            };
+            let mut r = problem(StatusCode::TOO_MANY_REQUESTS, "Queue full", &d);
+            r.headers_mut().insert(header::RETRY_AFTER, header::HeaderValue::from_static("30"));
+            Err(r)
+        }
+        Ok(_) => Ok(()),
+        Err(e) => Err(internal(e)),
+    }
+}
+
+/// A queued job for a valid case.
+pub(super) fn new_job(case: &Case, warnings: &[Problem]) -> Job {
+    Job {
+        id: new_id(),
+        name: case.name.clone(),
+        status: Status::Queued,
+        created_at: now_rfc3339(),
+        started_at: None,
+        finished_at: None,
+        time_s: 0.0,
+        end_time_s: case.end_time_s,
+        steps: 0,
+        wall_s: 0.0,
+        eta_s: None,
+        message: None,
+        warnings: case_problems(warnings),
+        plan: None,
+        cancel_requested: false,
+        attempts: 0,
+    }
+}
+
 /// `application/json` or `application/*+json`, with any parameters, in any case.
 fn is_json_media_type(ct: &str) -> bool {
     let t = ct.split(';').next().unwrap_or("").trim().to_ascii_lowercase();
@@ -156,7 +191,7 @@ fn is_json_media_type(ct: &str) -> bool {
 }
 
 /// 422 with every problem named by its JSON pointer.
-fn invalid_case(errors: &[Problem], warnings: &[Problem]) -> Response {
+pub(super) fn invalid_case(errors: &[Problem], warnings: &[Problem]) -> Response {
     let detail = errors.iter().map(|p| p.to_string()).collect::<Vec<_>>().join("; ");
     let mut doc = fluidbed_api::Problem::new(422, "Invalid case", &detail);
     doc.errors = Some(errors.iter().map(FieldError::from).collect());
@@ -258,15 +293,29 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
         Ok(j) => j,
         Err(r) => return r,
     };
+    if let Err(r) = cancel_job(&app, &job).await {
+        return r;
+    }
+    match app.store.get(&id) {
+        Ok(Some(j)) => (StatusCode::ACCEPTED, Json(j.to_api())).into_response(),
+        Ok(None) => no_job(),
+        Err(e) => internal(e),
+    }
+}
+
+/// Cancel one job (see `cancel`): Ok once the cancel is stored, or the answer to send instead.
+#[allow(clippy::result_large_err)]
+pub(super) async fn cancel_job(app: &Arc<App>, job: &Job) -> Result<(), Response> {
+    let id = job.id.clone();
     match job.status {
         Status::Succeeded | Status::Failed => {
-            return problem(
+            return Err(problem(
                 StatusCode::CONFLICT,
                 "Job already finished",
                 &format!("the job has {}", job.status.as_str()),
-            )
+            ))
         }
-        Status::Cancelled => return Json(job.to_api()).into_response(),
+        Status::Cancelled => return Ok(()),
         Status::Queued | Status::Running => {}
     }
     // Stored before the answer, so that a cancel survives a server stop.
@@ -274,10 +323,10 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
     let job_id = id.clone();
     match tokio::task::spawn_blocking(move || a.store.request_cancel(&job_id)).await {
         Ok(Ok(_)) => {}
-        Ok(Err(e)) => return internal(e),
-        Err(e) => return internal(e.into()),
+        Ok(Err(e)) => return Err(internal(e)),
+        Err(e) => return Err(internal(e.into())),
     }
-    cancel_flag(&app, &id).store(true, Ordering::SeqCst);
+    cancel_flag(app, &id).store(true, Ordering::SeqCst);
     if job.status == Status::Queued {
         if let Ok(true) = app.store.records().cancel_queued(&id, "cancelled before it started", &now_rfc3339()) {
             if let Ok(Some(j)) = app.store.get(&id) {
@@ -286,11 +335,7 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
             }
         }
     }
-    match app.store.get(&id) {
-        Ok(Some(j)) => (StatusCode::ACCEPTED, Json(j.to_api())).into_response(),
-        Ok(None) => no_job(),
-        Err(e) => internal(e),
-    }
+    Ok(())
 }
 
 /// A Last-Event-ID: a snapshot number up to MAX_OFFSET (the next one is then n + 1).

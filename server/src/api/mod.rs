@@ -7,6 +7,7 @@ mod downloads;
 mod jobs;
 pub mod openapi;
 pub mod problem;
+mod sweeps;
 
 use crate::App;
 use axum::extract::{DefaultBodyLimit, Request, State};
@@ -31,6 +32,8 @@ pub fn routes() -> OpenApiRouter<Arc<App>> {
         .routes(routes!(downloads::list))
         .routes(routes!(downloads::one))
         .routes(routes!(downloads::pressure_drop))
+        .routes(routes!(sweeps::list, sweeps::create))
+        .routes(routes!(sweeps::get_one, sweeps::cancel))
         .routes(routes!(analysis::get))
         .routes(routes!(analysis::figure))
         .routes(routes!(schema))

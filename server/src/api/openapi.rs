@@ -25,6 +25,7 @@ use utoipa::{Modify, OpenApi};
     components(schemas(StatusEvent, ProgressEvent, SnapshotEvent)),
     tags(
         (name = "jobs", description = "Submit, list, watch and cancel jobs"),
+        (name = "sweeps", description = "Submit a base case and a grid of values as one job per point; their summaries"),
         (name = "results", description = "Snapshots and the pressure-drop series"),
         (name = "meta", description = "Schemas, health, metrics"),
         (name = "page", description = "The live page (static files; no token)"),
@@ -49,6 +50,8 @@ impl Modify for BearerToken {
 pub fn document() -> Value {
     let mut doc = serde_json::to_value(super::routes().into_openapi()).expect("the document serialises");
     fluidbed_api::case_schema::merge_into(&mut doc);
+    // A sweep's base is a case.
+    doc["components"]["schemas"]["SweepRequest"]["properties"]["base"] = json!({ "$ref": fluidbed_api::case_schema::CASE_REF, "description": "A case; each point's values are set in a copy of it." });
     doc["components"]["schemas"][fluidbed_api::events::STREAM_EVENT] = fluidbed_api::events::stream_event_schema();
     declare_unauthorized(&mut doc);
     doc

@@ -18,7 +18,7 @@ mod sqlite;
 use crate::job::{Job, SnapshotInfo, Status};
 use anyhow::{bail, Context, Result};
 use fluidbed_core::sim::snapshot::Snapshot;
-pub use records::{EventKind, Lease, Notice, NoticeSink, Records};
+pub use records::{EventKind, Lease, Notice, NoticeSink, Records, SweepRecord};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -174,6 +174,18 @@ impl Store {
         owner: Option<&str>,
     ) -> Result<bool> {
         self.records.finish(id, status, message, now, owner)
+    }
+
+    /// Insert a sweep and its jobs, all or none.
+    pub fn insert_sweep(&self, sweep: &SweepRecord, jobs: &[(Job, String)]) -> Result<()> {
+        self.records.insert_sweep(sweep, jobs)
+    }
+    pub fn sweep(&self, id: &str) -> Result<Option<SweepRecord>> {
+        self.records.sweep(id)
+    }
+    /// Newest first. Returns (page, total).
+    pub fn sweeps(&self, limit: usize, offset: usize) -> Result<(Vec<SweepRecord>, usize)> {
+        self.records.sweeps(limit, offset)
     }
 
     /// Store snapshot `s`; the bytes written.

@@ -5,7 +5,7 @@
 //! The calls are synchronous like SQLite's: each runs as a task on this backend's own runtime and
 //! the caller waits for its answer, so the code above needs no async and no knowledge of it.
 
-use super::records::{Lease, Notice, NoticeSink, Records};
+use super::records::{Lease, Notice, NoticeSink, Records, SweepRecord};
 use crate::job::{Job, SnapshotInfo, Status};
 use anyhow::{anyhow, Context, Result};
 use deadpool_postgres::{Manager, ManagerConfig, Pool, RecyclingMethod};
@@ -76,6 +76,11 @@ fn info_of(r: &Row) -> Result<SnapshotInfo> {
         pressure_drop_pa: r.try_get(3)?,
         mean_particle_height_m: r.try_get(4)?,
     })
+}
+
+fn sweep_of(r: &Row) -> Result<SweepRecord> {
+    let points: String = r.try_get(3)?;
+    SweepRecord::from_columns(r.try_get(0)?, r.try_get(1)?, r.try_get(2)?, &points)
 }
 
 /// The URL without its password, for messages.
@@ -393,6 +398,60 @@ impl Records for Postgres {
             params![s(id), n as i64],
         )?;
         rows.first().map(info_of).transpose()
+    }
+
+    fn insert_sweep(&self, sweep: &SweepRecord, jobs: &[(Job, String)]) -> Result<()> {
+        let pool = self.pool.clone();
+        let jobs: Vec<([String; 6], f64)> = jobs
+            .iter()
+            .map(|(j, case)| -> Result<([String; 6], f64)> {
+                let text = [
+                    j.id.clone(),
+                    j.name.clone(),
+                    s(j.status.as_str()),
+                    case.clone(),
+                    j.created_at.clone(),
+                    serde_json::to_string(&j.warnings)?,
+                ];
+                Ok((text, j.end_time_s))
+            })
+            .collect::<Result<_>>()?;
+        let row = [sweep.id.clone(), sweep.name.clone(), sweep.created_at.clone(), sweep.points_json()];
+        self.run(async move {
+            let mut c = pool.get().await?;
+            let tx = c.transaction().await?;
+            for (j, end_time_s) in &jobs {
+                tx.execute(
+                    "INSERT INTO jobs (id, name, status, case_json, created_at, end_time_s, warnings) VALUES ($1, $2, $3, $4, $5, $6, $7)",
+                    &[&j[0], &j[1], &j[2], &j[3], &j[4], end_time_s, &j[5]],
+                )
+                .await?;
+            }
+            tx.execute(
+                "INSERT INTO sweeps (id, name, created_at, points) VALUES ($1, $2, $3, $4)",
+                &[&row[0], &row[1], &row[2], &row[3]],
+            )
+            .await?;
+            tx.commit().await?;
+            Ok(())
+        })
+    }
+
+    fn sweep(&self, id: &str) -> Result<Option<SweepRecord>> {
+        let rows =
+            self.query("SELECT id, name, created_at, points FROM sweeps WHERE id = $1".into(), params![s(id)])?;
+        rows.first().map(sweep_of).transpose()
+    }
+
+    fn sweeps(&self, limit: usize, offset: usize) -> Result<(Vec<SweepRecord>, usize)> {
+        let rows = self.query(
+            "SELECT id, name, created_at, points FROM sweeps ORDER BY seq DESC LIMIT $1 OFFSET $2".into(),
+            params![limit as i64, offset as i64],
+        )?;
+        let sweeps = rows.iter().map(sweep_of).collect::<Result<Vec<_>>>()?;
+        let total = self.query("SELECT COUNT(*) FROM sweeps".into(), params![])?;
+        let total: i64 = total.first().map(|r| r.try_get(0)).transpose()?.unwrap_or(0);
+        Ok((sweeps, total as usize))
     }
 
     fn notify(&self, notice: Notice) {

@@ -41,6 +41,35 @@ impl Notice {
     }
 }
 
+/// A sweep as the records keep it: its points in order, each the job made for it and the values
+/// set in the base case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SweepRecord {
+    pub id: String,
+    pub name: String,
+    pub created_at: String,
+    pub points: Vec<(String, serde_json::Map<String, serde_json::Value>)>,
+}
+
+impl SweepRecord {
+    pub fn points_json(&self) -> String {
+        let pts: Vec<serde_json::Value> =
+            self.points.iter().map(|(job, set)| serde_json::json!({ "job": job, "set": set })).collect();
+        serde_json::Value::Array(pts).to_string()
+    }
+    pub fn from_columns(id: String, name: String, created_at: String, points: &str) -> Result<SweepRecord> {
+        let pts: Vec<serde_json::Value> = serde_json::from_str(points)?;
+        let points = pts
+            .into_iter()
+            .map(|p| {
+                let job = p["job"].as_str().unwrap_or_default().to_string();
+                (job, p["set"].as_object().cloned().unwrap_or_default())
+            })
+            .collect();
+        Ok(SweepRecord { id, name, created_at, points })
+    }
+}
+
 /// Called with each notice from another node.
 pub type NoticeSink = Box<dyn Fn(Notice) + Send + Sync>;
 
@@ -89,6 +118,12 @@ pub trait Records: Send + Sync {
     fn put_snapshot_info(&self, id: &str, info: &SnapshotInfo) -> Result<()>;
     fn snapshots(&self, id: &str) -> Result<Vec<SnapshotInfo>>;
     fn snapshot_info(&self, id: &str, n: u64) -> Result<Option<SnapshotInfo>>;
+
+    /// Insert a sweep and its jobs (each with its case JSON) in one transaction: all or none.
+    fn insert_sweep(&self, sweep: &SweepRecord, jobs: &[(Job, String)]) -> Result<()>;
+    fn sweep(&self, id: &str) -> Result<Option<SweepRecord>>;
+    /// Newest first. Returns (page, total).
+    fn sweeps(&self, limit: usize, offset: usize) -> Result<(Vec<SweepRecord>, usize)>;
 
     /// Tell the other nodes (in publishing order); nothing on a backend that is not shared.
     fn notify(&self, notice: Notice);

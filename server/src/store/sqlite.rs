@@ -2,7 +2,7 @@
 //! single server. Leases are kept as on PostgreSQL, but a start frees them all: no other node
 //! can hold one.
 
-use super::records::{unix_now, Lease, Notice, NoticeSink, Records};
+use super::records::{unix_now, Lease, Notice, NoticeSink, Records, SweepRecord};
 use crate::job::{Job, SnapshotInfo, Status};
 use anyhow::{Context, Result};
 use rusqlite::{params, Connection, OptionalExtension};
@@ -262,6 +262,49 @@ impl Records for Sqlite {
                 info_of,
             )
             .optional()?)
+    }
+
+    fn insert_sweep(&self, sweep: &SweepRecord, jobs: &[(Job, String)]) -> Result<()> {
+        let mut db = self.db();
+        let tx = db.transaction()?;
+        for (job, case_json) in jobs {
+            tx.execute(
+                "INSERT INTO jobs (id, name, status, case_json, created_at, end_time_s, warnings) VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7)",
+                params![job.id, job.name, job.status.as_str(), case_json, job.created_at, job.end_time_s, serde_json::to_string(&job.warnings)?],
+            )?;
+        }
+        tx.execute(
+            "INSERT INTO sweeps (id, name, created_at, points) VALUES (?1, ?2, ?3, ?4)",
+            params![sweep.id, sweep.name, sweep.created_at, sweep.points_json()],
+        )?;
+        tx.commit()?;
+        Ok(())
+    }
+
+    fn sweep(&self, id: &str) -> Result<Option<SweepRecord>> {
+        let row = self
+            .db()
+            .query_row("SELECT id, name, created_at, points FROM sweeps WHERE id = ?1", [id], |r| {
+                Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get::<_, String>(3)?))
+            })
+            .optional()?;
+        row.map(|(id, name, at, pts)| SweepRecord::from_columns(id, name, at, &pts)).transpose()
+    }
+
+    fn sweeps(&self, limit: usize, offset: usize) -> Result<(Vec<SweepRecord>, usize)> {
+        let db = self.db();
+        let rows = db
+            .prepare("SELECT id, name, created_at, points FROM sweeps ORDER BY seq DESC LIMIT ?1 OFFSET ?2")?
+            .query_map(params![limit as i64, offset as i64], |r| {
+                Ok((r.get(0)?, r.get(1)?, r.get(2)?, r.get::<_, String>(3)?))
+            })?
+            .collect::<Result<Vec<(String, String, String, String)>, _>>()?;
+        let total: i64 = db.query_row("SELECT COUNT(*) FROM sweeps", [], |r| r.get(0))?;
+        let sweeps = rows
+            .into_iter()
+            .map(|(id, name, at, pts)| SweepRecord::from_columns(id, name, at, &pts))
+            .collect::<Result<_>>()?;
+        Ok((sweeps, total as usize))
     }
 
     fn notify(&self, _notice: Notice) {}
