@@ -1,6 +1,7 @@
 //! Server-sent events of a job: `status`, `progress`, `snapshot` (id = snapshot number) and a
 //! final `end` event, after which the stream closes. A client connecting late, or resuming with
-//! `Last-Event-ID: n`, first gets the stored snapshots after n, then the live events.
+//! `Last-Event-ID: n`, first gets the stored snapshots after n, then the live events; a gap in
+//! the live numbers is filled from the store, so every stream has every snapshot once, in order.
 
 use crate::job::SnapshotInfo;
 use crate::App;
@@ -120,6 +121,13 @@ pub async fn pump(app: Arc<App>, id: String, last_seen: Option<u64>, tx: mpsc::S
     loop {
         match live.recv().await {
             Ok(ev) => {
+                // A snapshot past the next one expected, or the end: first what the store holds
+                // in between (the notices of a node killed after its writes never came).
+                if ev.n.is_some_and(|n| n > next) || ev.kind == EventKind::End {
+                    if !replay(&app, &id, &mut next, &tx).await {
+                        return;
+                    }
+                }
                 if let Some(n) = ev.n {
                     if n < next {
                         continue;

@@ -1,9 +1,10 @@
-//! Three fluidbed server processes on one PostgreSQL and one shared data directory: six short
+//! Three fluidbed server processes on one PostgreSQL and one shared data directory: twenty short
 //! jobs submitted through two of them, one node killed with SIGKILL mid-run. Every job ends
-//! succeeded exactly once (the killed node's resumed elsewhere from their checkpoints, to the same
-//! final state as the jobs that ran uninterrupted), the event streams read through the third node
-//! are complete and in order, a resumed stream through another node starts right after its
-//! Last-Event-ID, and a cancel sent to a node that does not run the job stops it.
+//! succeeded exactly once (the killed node's resumed elsewhere from their checkpoints, to a final
+//! state bit-identical to the jobs that ran uninterrupted), the event streams read through the
+//! third node are complete and in order, a resumed stream through another node starts right after
+//! its Last-Event-ID, a sweep submitted to one node is followed to its summary through another,
+//! and a cancel sent to a node that does not run the job stops it.
 
 use fluidbed_tests::postgres::PgCluster;
 use fluidbed_tests::*;
@@ -14,7 +15,7 @@ use std::time::{Duration, Instant};
 
 /// Short enough that a takeover comes soon after a kill.
 const LEASE_S: &str = "2";
-const JOBS: usize = 6;
+const JOBS: usize = 20;
 
 struct Node {
     child: Child,
@@ -174,8 +175,8 @@ async fn three_nodes_share_one_queue_and_survive_a_kill() {
     }
     assert!(resumed >= 1, "node A was killed while running no job");
 
-    // The streams through C: every snapshot once and in order, then `end`; the same final state
-    // for every job (the resumed ones included: one case, one thread each).
+    // The streams through C: every snapshot once and in order, then `end`; the same final state,
+    // bit for bit, for every job (the resumed ones included: one case, one thread each).
     let mut last_snapshots = Vec::new();
     for (id, s) in ids.iter().zip(streams) {
         let events = tokio::time::timeout(Duration::from_secs(60), s).await.expect("stream ended").unwrap();
@@ -192,7 +193,7 @@ async fn three_nodes_share_one_queue_and_survive_a_kill() {
     for (k, s) in last_snapshots.iter().enumerate().skip(1) {
         for field in ["voidage", "pressure_pa"] {
             let d = largest_difference(&s[field], &last_snapshots[0][field]);
-            assert!(d <= 1e-9 * 1e5, "job {k}'s final {field} differs from job 0's by {d}");
+            assert_eq!(d, 0.0, "job {k}'s final {field} differs from job 0's by {d}");
         }
     }
 
@@ -201,6 +202,27 @@ async fn three_nodes_share_one_queue_and_survive_a_kill() {
     let ids_after = snapshot_ids(&again);
     assert_eq!(ids_after.first(), Some(&5), "resumed after 4: {ids_after:?}");
     assert_eq!(again.last().map(|e| e.event.as_str()), Some("end"));
+
+    // A sweep submitted to B, followed through C to every point's summary.
+    let sweep_case = small_bubbling_case("cluster sweep", 0.006, 0.001);
+    let body = serde_json::json!({"base": sweep_case, "grid": [{"pointer": "/gas/superficial_velocity_m_s", "values": [0.6, 0.9]}]});
+    let r = http.post(format!("{}/v1/sweeps", b.url)).json(&body).send().await.unwrap();
+    assert_eq!(r.status(), 201);
+    let sweep_id = r.json::<Value>().await.unwrap()["id"].as_str().unwrap().to_string();
+    let t2 = Instant::now();
+    let sweep = loop {
+        let s = get(&http, &format!("{}/v1/sweeps/{sweep_id}", c.url)).await;
+        if s["status"] != "queued" && s["status"] != "running" {
+            break s;
+        }
+        assert!(t2.elapsed() < Duration::from_secs(120), "the sweep did not end: {s}");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert_eq!(sweep["status"], "succeeded", "{sweep}");
+    for p in sweep["points"].as_array().unwrap() {
+        assert!(p["summary"]["samples"].as_u64().unwrap() >= 3, "{p}");
+        assert_eq!(p["summary"]["superficial_velocity_m_s"], p["set"]["/gas/superficial_velocity_m_s"]);
+    }
 
     // A cancel through the node that does not run the job stops it.
     let mut long = small_bubbling_case("cluster cancel", 10.0, 0.001);
