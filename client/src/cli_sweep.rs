@@ -190,9 +190,12 @@ pub fn summary_csv(s: &Sweep) -> String {
     std::iter::once(head).chain(body).map(|r| r.iter().map(quote).collect::<Vec<_>>().join(",") + "\n").collect()
 }
 
-/// An aligned text table of the same rows.
+/// An aligned text table of the same rows, without the columns no point has a value in.
 pub fn summary_table(s: &Sweep) -> String {
     let (head, body) = rows(s);
+    let keep: Vec<bool> = (0..head.len()).map(|c| body.iter().any(|r| !r[c].is_empty())).collect();
+    let pick = |r: Vec<String>| r.into_iter().zip(&keep).filter(|(_, k)| **k).map(|(f, _)| f).collect::<Vec<_>>();
+    let (head, body): (Vec<String>, Vec<Vec<String>>) = (pick(head), body.into_iter().map(pick).collect());
     let mut width: Vec<usize> = head.iter().map(|h| h.chars().count()).collect();
     for r in &body {
         for (w, f) in width.iter_mut().zip(r) {

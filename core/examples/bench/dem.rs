@@ -14,7 +14,7 @@ use std::time::Instant;
 const ANCHOR: &str = "../shared/anchors/settled_25000.data.gz";
 
 /// The anchor scene: paper Table 1 particles with e = 0.9 for normal and tangential damping.
-fn bench_case() -> Case {
+pub fn bench_case() -> Case {
     let mut c: Case = serde_json::from_str(
         r#"{"column":{"diameter_m":0.044,"height_m":0.06},"particles":{},"bed":{"generated":{"count":25000,"seed":1}}}"#,
     )
@@ -33,7 +33,7 @@ fn bench_case() -> Case {
 }
 
 /// Positions from the LAMMPS data file (columns id type diameter density x y z), in id order.
-fn load_anchor() -> Option<Vec<[f64; 3]>> {
+pub fn load_anchor() -> Option<Vec<[f64; 3]>> {
     let candidates =
         [ANCHOR.to_string(), format!("{}/../../shared/anchors/settled_25000.data.gz", env!("CARGO_MANIFEST_DIR"))];
     let path = candidates.iter().find(|p| std::path::Path::new(p).exists())?;

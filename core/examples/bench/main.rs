@@ -1,9 +1,10 @@
-//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled|scaling>`.
+//! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled|scaling|halo|…>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
 mod cfd;
 mod coupled;
 mod dem;
+mod halo;
 mod restitution;
 mod scaling;
 mod tradeoff;
@@ -29,6 +30,7 @@ fn run(what: &str) {
         "scaling" => scaling::run(),
         "restitution" => restitution::run(),
         "dem" => dem::run(),
+        "halo" => halo::run(),
         "voidage" => voidage::run(),
         other => {
             eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage, coupled, scaling");
