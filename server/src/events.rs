@@ -123,10 +123,9 @@ pub async fn pump(app: Arc<App>, id: String, last_seen: Option<u64>, tx: mpsc::S
             Ok(ev) => {
                 // A snapshot past the next one expected, or the end: first what the store holds
                 // in between (the notices of a node killed after its writes never came).
-                if ev.n.is_some_and(|n| n > next) || ev.kind == EventKind::End {
-                    if !replay(&app, &id, &mut next, &tx).await {
-                        return;
-                    }
+                let gap = ev.n.is_some_and(|n| n > next) || ev.kind == EventKind::End;
+                if gap && !replay(&app, &id, &mut next, &tx).await {
+                    return;
                 }
                 if let Some(n) = ev.n {
                     if n < next {
