@@ -5,6 +5,7 @@ mod cfd;
 mod coupled;
 mod dem;
 mod halo;
+mod plan;
 mod restitution;
 mod scaling;
 mod tradeoff;
@@ -31,6 +32,7 @@ fn run(what: &str) {
         "restitution" => restitution::run(),
         "dem" => dem::run(),
         "halo" => halo::run(),
+        "plan" => plan::run(),
         "voidage" => voidage::run(),
         other => {
             eprintln!("unknown benchmark {other:?}; choose dem, cfd, voidage, coupled, scaling");

@@ -354,6 +354,8 @@ pub fn fluid_grid(case: &Case) -> CylGrid {
 }
 
 #[cfg(test)]
+mod plan_tests;
+#[cfg(test)]
 mod resume_tests;
 #[cfg(test)]
 mod tests;

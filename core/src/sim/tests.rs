@@ -3,7 +3,7 @@ use crate::case::{Bed, ExplicitBed, Gas};
 
 /// A case with an explicit bed: particles on a cubic lattice of spacing `s`·d filling the column
 /// up to `bed_h`, at rest.
-fn lattice_case(diameter: f64, height: f64, bed_h: f64, s: f64, gas: Option<Gas>) -> Case {
+pub(super) fn lattice_case(diameter: f64, height: f64, bed_h: f64, s: f64, gas: Option<Gas>) -> Case {
     let d = 0.0012;
     let r = diameter / 2.0;
     let a = s * d;

@@ -293,19 +293,22 @@ pub async fn cancel(State(app): State<Arc<App>>, Path(id): Path<String>) -> Resp
         Ok(j) => j,
         Err(r) => return r,
     };
-    if let Err(r) = cancel_job(&app, &job).await {
-        return r;
-    }
+    let code = match cancel_job(&app, &job).await {
+        Ok(true) => StatusCode::ACCEPTED,
+        Ok(false) => StatusCode::OK,
+        Err(r) => return r,
+    };
     match app.store.get(&id) {
-        Ok(Some(j)) => (StatusCode::ACCEPTED, Json(j.to_api())).into_response(),
+        Ok(Some(j)) => (code, Json(j.to_api())).into_response(),
         Ok(None) => no_job(),
         Err(e) => internal(e),
     }
 }
 
-/// Cancel one job (see `cancel`): Ok once the cancel is stored, or the answer to send instead.
+/// Cancel one job (see `cancel`): Ok(true) once the cancel is stored, Ok(false) if the job was
+/// already cancelled, or the answer to send instead.
 #[allow(clippy::result_large_err)]
-pub(super) async fn cancel_job(app: &Arc<App>, job: &Job) -> Result<(), Response> {
+pub(super) async fn cancel_job(app: &Arc<App>, job: &Job) -> Result<bool, Response> {
     let id = job.id.clone();
     match job.status {
         Status::Succeeded | Status::Failed => {
@@ -315,7 +318,7 @@ pub(super) async fn cancel_job(app: &Arc<App>, job: &Job) -> Result<(), Response
                 &format!("the job has {}", job.status.as_str()),
             ))
         }
-        Status::Cancelled => return Ok(()),
+        Status::Cancelled => return Ok(false),
         Status::Queued | Status::Running => {}
     }
     // Stored before the answer, so that a cancel survives a server stop.
@@ -335,7 +338,7 @@ pub(super) async fn cancel_job(app: &Arc<App>, job: &Job) -> Result<(), Response
             }
         }
     }
-    Ok(())
+    Ok(true)
 }
 
 /// A Last-Event-ID: a snapshot number up to MAX_OFFSET (the next one is then n + 1).
