@@ -133,9 +133,15 @@ pub struct Job {
     pub message: Option<String>,
     /// The case's validation warnings.
     pub warnings: Vec<CaseProblem>,
-    /// Which solver parts run (decided when the run is built; null before).
+    /// Which solver parts run (decided when the run is built; null before), with `skipped`:
+    /// each part that does not run and why.
     #[schema(value_type = Option<Object>)]
     pub plan: Option<Value>,
+    /// Wall seconds per stage since the job last (re)started: neighbours, contacts_integration,
+    /// voidage, exchange, gas, output (null before the first progress report).
+    #[serde(default)]
+    #[schema(value_type = Option<Object>)]
+    pub stage_seconds: Option<Value>,
     pub links: JobLinks,
 }
 

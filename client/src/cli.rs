@@ -225,6 +225,11 @@ async fn dispatch(cli: Cli) -> i32 {
         Verb::Status { id } => match api.job(&id).await {
             Ok(v) => {
                 print_job(&v, j);
+                if !j {
+                    for line in crate::plan_view::plan_lines(&v).into_iter().chain(crate::plan_view::stage_line(&v)) {
+                        println!("  {line}");
+                    }
+                }
                 exit::OK
             }
             Err(e) => api_fail(e, j),

@@ -95,6 +95,13 @@ async fn submit_watch_fetch(api: &Api, text: &str, out: &std::path::Path, format
         Err(e) => return api_fail(e, json_out),
     };
     report_outcome(&id, outcome.status, outcome.message.as_deref(), false);
+    if !json_out {
+        if let Ok(job) = api.job(&id).await {
+            for line in crate::plan_view::plan_lines(&job).into_iter().chain(crate::plan_view::stage_line(&job)) {
+                eprintln!("fluidbed: {line}");
+            }
+        }
+    }
     if json_out {
         println!(
             "{}",

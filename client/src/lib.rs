@@ -8,6 +8,7 @@ mod cli_run;
 mod cli_sweep;
 pub mod fetch;
 mod outcome;
+mod plan_view;
 mod validate;
 pub mod watch;
 

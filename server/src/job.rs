@@ -22,6 +22,8 @@ pub struct Job {
     pub message: Option<String>,
     pub warnings: Vec<CaseProblem>,
     pub plan: Option<Value>,
+    /// Wall seconds per stage since the job last (re)started.
+    pub stage_seconds: Option<Value>,
     /// A DELETE was accepted: the job ends `cancelled` even across a restart.
     pub cancel_requested: bool,
     /// Starts not given back by a clean stop: how often this job went down with its server.
@@ -54,6 +56,7 @@ impl Job {
             message: self.message.clone(),
             warnings: self.warnings.clone(),
             plan: self.plan.clone(),
+            stage_seconds: self.stage_seconds.clone(),
             links: JobLinks::of(&self.id),
         }
     }

@@ -248,7 +248,9 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, lost: &AtomicBool, base_
         finish(app, id, Status::Cancelled, Some("cancelled by request"));
         return Ok(());
     }
-    app.store.set_plan(id, &serde_json::to_value(sim.plan())?)?;
+    let mut plan = serde_json::to_value(sim.plan())?;
+    plan["skipped"] = serde_json::to_value(sim.plan().skipped(sim.case()))?;
+    app.store.set_plan(id, &plan)?;
     // The ETA's rate counts stepping only, not the preparation before it.
     let started = Instant::now();
     let checkpoint_every = sim.case().outputs.checkpoint_interval_s;
@@ -308,6 +310,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, lost: &AtomicBool, base_
         app.metrics.job_running(id, job_rate(stepped / started.elapsed().as_secs_f64().max(1e-9), sim.timers()));
         if last_progress.elapsed() >= PROGRESS_EVERY || sim.is_finished() {
             last_progress = Instant::now();
+            app.store.set_stages(id, &stage_seconds(sim.timers()))?;
             app.store.set_progress(id, sim.time(), end, sim.steps(), wall, eta)?;
             if let Some(job) = app.store.get(id)? {
                 app.hub.publish(id, JobEvent::new(EventKind::Progress, None, &job.progress_event()));
@@ -343,17 +346,26 @@ fn put_checkpoint(app: &App, id: &str, sim: &Simulation) -> Result<()> {
     Ok(())
 }
 
-/// The metrics of a running job: its stepping rate and wall time per stage.
-fn job_rate(steps_per_s: f64, t: &StageTimers) -> JobRate {
-    let stages = vec![
+/// Wall seconds per stage, by name.
+fn stages_of(t: &StageTimers) -> Vec<(&'static str, f64)> {
+    vec![
         ("neighbours", t.neighbours),
         ("contacts_integration", t.contacts_integration),
         ("voidage", t.voidage),
         ("exchange", t.exchange),
         ("gas", t.gas),
         ("output", t.output),
-    ];
-    JobRate { steps_per_s, stages }
+    ]
+}
+
+/// The job status's `stage_seconds`.
+fn stage_seconds(t: &StageTimers) -> serde_json::Value {
+    serde_json::Value::Object(stages_of(t).into_iter().map(|(k, v)| (k.to_string(), v.into())).collect())
+}
+
+/// The metrics of a running job: its stepping rate and wall time per stage.
+fn job_rate(steps_per_s: f64, t: &StageTimers) -> JobRate {
+    JobRate { steps_per_s, stages: stages_of(t) }
 }
 
 fn fail(app: &Arc<App>, id: &str, message: &str) -> Result<()> {

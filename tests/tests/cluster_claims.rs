@@ -25,6 +25,7 @@ fn job(id: &str) -> Job {
         message: None,
         warnings: vec![],
         plan: None,
+        stage_seconds: None,
         cancel_requested: false,
         attempts: 0,
     }

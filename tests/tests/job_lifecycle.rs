@@ -51,6 +51,12 @@ async fn submitted_case_streams_events_and_every_download_checks_out() {
     assert_eq!(job["progress"], 1.0);
     assert!((job["time_s"].as_f64().unwrap() - 0.02).abs() < 1e-12);
     assert!(job["steps"].as_u64().unwrap() > 0 && job["plan"].is_object());
+    // The plan says what is skipped and why; the status has the wall time of each stage.
+    let skipped: Vec<&str> = job["plan"]["skipped"].as_array().unwrap().iter().filter_map(Value::as_str).collect();
+    assert!(skipped.contains(&"gas solver: the case has no gas section"), "{skipped:?}");
+    let stages = &job["stage_seconds"];
+    assert!(stages["contacts_integration"].as_f64().unwrap() > 0.0, "{stages}");
+    assert_eq!(stages["gas"].as_f64(), Some(0.0), "{stages}");
 
     let list: Value = http.get(format!("{url}/snapshots")).send().await.unwrap().json().await.unwrap();
     let list = list["snapshots"].as_array().unwrap().clone();

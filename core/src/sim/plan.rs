@@ -53,3 +53,45 @@ impl Plan {
         }
     }
 }
+
+impl Plan {
+    /// Each part of the solver this plan does not run, and why (for the job's status).
+    pub fn skipped(&self, case: &Case) -> Vec<String> {
+        let mut out = Vec::new();
+        if !self.particles_move {
+            out.push(if case.dem.frozen {
+                "contacts and particle integration: the bed is frozen (dem.frozen)".to_string()
+            } else {
+                "contacts and particle integration: no particles".to_string()
+            });
+        } else if !self.tangential {
+            out.push("tangential history and spin: frictionless particles (particles.sliding_friction = 0)".into());
+        }
+        if !self.gas {
+            out.push("gas solver: the case has no gas section".into());
+        } else if let Some(g) = self.gas_dt_s.filter(|_| self.gas_steps_per_dem_step < 1.0) {
+            out.push(format!(
+                "gas steps: sub-cycled at its stable step {:.3} µs, {:.2} gas steps per DEM step",
+                g * 1e6,
+                self.gas_steps_per_dem_step
+            ));
+        }
+        if self.gas && !self.coupling {
+            out.push("voidage, drag and exchange: no particles".into());
+        } else if self.coupling && !self.particles_move {
+            out.push("voidage and per-particle drag: computed once for the frozen bed (O(cells) exchange)".into());
+        } else if self.coupling && self.coupling_interval > 1 {
+            out.push(format!(
+                "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), held in between",
+                self.coupling_interval
+            ));
+        }
+        if !self.voidage_field {
+            out.push("voidage field in snapshots: not in outputs.fields".into());
+        }
+        if !self.particle_field {
+            out.push("particle positions in snapshots: not in outputs.fields".into());
+        }
+        out
+    }
+}

@@ -41,6 +41,7 @@ fn frictionless_particles_move_as_on_the_friction_path_with_no_friction() {
     let (smooth, _) = run(falling(0.0));
     let (rough, _) = run(falling(1e-300));
     assert!(!smooth.plan().tangential && rough.plan().tangential);
+    assert!(smooth.plan().skipped(smooth.case()).iter().any(|s| s.contains("sliding_friction = 0")));
     // The rough particles spin (so the friction path ran), by no more than round-off allows.
     let spin = rough.dem().angular_velocities().iter().flatten().fold(0.0f64, |m, w| m.max(w.abs()));
     let moved = smooth.dem().velocities().iter().any(|v| v[2].abs() > 0.05);
@@ -114,6 +115,7 @@ fn a_frozen_packed_bed_has_the_pressure_drop_of_the_same_bed_stepped_at_rest() {
     frozen.dem.frozen = true;
     let ((f, sf), (m, sm)) = (run(frozen), run(at_rest()));
     assert!(!f.plan().particles_move && m.plan().particles_move);
+    assert!(f.plan().skipped(f.case()).iter().any(|s| s.contains("dem.frozen")), "{:?}", f.plan().skipped(f.case()));
     let moved = largest_difference(f.dem().positions(), m.dem().positions());
     assert!(moved < 1e-6, "the stepped bed moved {moved} m");
     assert_eq!(sf.len(), 6);

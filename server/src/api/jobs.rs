@@ -179,6 +179,7 @@ pub(super) fn new_job(case: &Case, warnings: &[Problem]) -> Job {
         message: None,
         warnings: case_problems(warnings),
         plan: None,
+        stage_seconds: None,
         cancel_requested: false,
         attempts: 0,
     }

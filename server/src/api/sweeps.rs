@@ -229,6 +229,7 @@ fn jobs_of(app: &App, record: &SweepRecord) -> anyhow::Result<Vec<Job>> {
                 message: Some("the point's job record is missing".into()),
                 warnings: Vec::new(),
                 plan: None,
+                stage_seconds: None,
                 cancel_requested: false,
                 attempts: 0,
             }))

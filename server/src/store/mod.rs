@@ -152,6 +152,9 @@ impl Store {
     pub fn set_plan(&self, id: &str, plan: &serde_json::Value) -> Result<()> {
         self.records.set_plan(id, plan)
     }
+    pub fn set_stages(&self, id: &str, stages: &serde_json::Value) -> Result<()> {
+        self.records.set_stages(id, stages)
+    }
     pub fn set_progress(
         &self,
         id: &str,

@@ -30,7 +30,7 @@ const CALL_TIMEOUT: Duration = Duration::from_secs(30);
 /// The database's clock as Unix seconds.
 const NOW: &str = "EXTRACT(EPOCH FROM clock_timestamp())::float8";
 
-const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts";
+const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts, stage_seconds";
 const INFO_COLUMNS: &str = "n, time_s, step, pressure_drop_pa, mean_particle_height_m";
 
 /// The parameters of one statement, owned (they travel to the runtime's task).
@@ -65,6 +65,7 @@ fn job_of(r: &Row) -> Result<Job> {
         plan: plan.and_then(|p| serde_json::from_str(&p).ok()),
         cancel_requested: r.try_get(14)?,
         attempts: r.try_get::<_, i32>(15)?.max(0) as u32,
+        stage_seconds: r.try_get::<_, Option<String>>(16)?.and_then(|t| serde_json::from_str(&t).ok()),
     })
 }
 
@@ -348,6 +349,11 @@ impl Records for Postgres {
 
     fn set_plan(&self, id: &str, plan: &serde_json::Value) -> Result<()> {
         self.execute("UPDATE jobs SET plan = $2 WHERE id = $1", params![s(id), plan.to_string()])?;
+        Ok(())
+    }
+
+    fn set_stages(&self, id: &str, stages: &serde_json::Value) -> Result<()> {
+        self.execute("UPDATE jobs SET stage_seconds = $2 WHERE id = $1", params![s(id), stages.to_string()])?;
         Ok(())
     }
 

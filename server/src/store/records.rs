@@ -102,6 +102,8 @@ pub trait Records: Send + Sync {
     fn cancel_queued(&self, id: &str, message: &str, now: &str) -> Result<bool>;
     fn set_message(&self, id: &str, message: Option<&str>) -> Result<()>;
     fn set_plan(&self, id: &str, plan: &serde_json::Value) -> Result<()>;
+    /// Wall seconds per stage of a running job.
+    fn set_stages(&self, id: &str, stages: &serde_json::Value) -> Result<()>;
     fn set_progress(
         &self,
         id: &str,

@@ -21,7 +21,7 @@ pub struct Sqlite {
 const ADDED_COLUMNS: [(&str, &str); 2] =
     [("cancel_requested", "INTEGER NOT NULL DEFAULT 0"), ("attempts", "INTEGER NOT NULL DEFAULT 0")];
 
-const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts";
+const JOB_COLUMNS: &str = "id, name, status, created_at, started_at, finished_at, time_s, end_time_s, steps, wall_s, eta_s, message, warnings, plan, cancel_requested, attempts, stage_seconds";
 
 fn job_of(r: &rusqlite::Row) -> rusqlite::Result<Job> {
     let status: String = r.get(2)?;
@@ -44,6 +44,7 @@ fn job_of(r: &rusqlite::Row) -> rusqlite::Result<Job> {
         plan: plan.and_then(|p| serde_json::from_str(&p).ok()),
         cancel_requested: r.get::<_, i64>(14)? != 0,
         attempts: r.get::<_, i64>(15)? as u32,
+        stage_seconds: r.get::<_, Option<String>>(16)?.and_then(|t| serde_json::from_str(&t).ok()),
     })
 }
 
@@ -211,6 +212,11 @@ impl Records for Sqlite {
         Ok(())
     }
 
+    fn set_stages(&self, id: &str, stages: &serde_json::Value) -> Result<()> {
+        self.db().execute("UPDATE jobs SET stage_seconds = ?2 WHERE id = ?1", params![id, stages.to_string()])?;
+        Ok(())
+    }
+
     fn set_progress(
         &self,
         id: &str,
@@ -344,6 +350,7 @@ mod tests {
             message: None,
             warnings: vec![],
             plan: None,
+            stage_seconds: None,
             cancel_requested: false,
             attempts: 0,
         }
