@@ -1,7 +1,9 @@
 //! Stress cases of the solver (issue 22): `cargo run --release -p fluidbed-core --example stress -- NAME`.
 //! `extremes [CASES] [SEED]`: seeded random cases inside and beyond the schema's ranges; prints a
 //! line per case, the outcome table, one stop message per kind, and last one JSON line.
+//! `dt-sweep`: the largest stable DEM and gas steps by bisection, beside the theoretical limits.
 
+mod dt_sweep;
 mod extremes;
 
 use std::time::Duration;
@@ -25,8 +27,9 @@ fn main() {
                 std::process::exit(1);
             }
         }
+        Some("dt-sweep") => dt_sweep::run(),
         other => {
-            eprintln!("usage: stress extremes [CASES] [SEED] (got {other:?})");
+            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep (got {other:?})");
             std::process::exit(2);
         }
     }

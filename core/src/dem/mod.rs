@@ -30,6 +30,7 @@ mod contact;
 mod contact_styles;
 mod diagnostics;
 mod forces;
+mod impact;
 mod integrator;
 mod kernel;
 mod list_upkeep;
@@ -54,6 +55,7 @@ mod tests;
 pub use crate::team::solver_pool;
 pub use bed::{build_bed, build_bed_until, fnv1a, Stop, STOPPED};
 pub use contact::{linear_damping_ratio, ContactLaw, ContactStyle, V3};
+pub use impact::{plate_impact, Impact};
 pub use kernel::{Kernel, KERNEL_ENV};
 pub use system::DemSystem;
 
