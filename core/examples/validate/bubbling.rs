@@ -52,11 +52,18 @@ pub fn run_to(end_s: f64) -> RunSummary {
     case.analysis.from_s = ANALYSIS_FROM_S;
     // named after the case it ran, so an edited case runs anew
     let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
-    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.json");
+    // bincode, not JSON: the analysis holds NaN where a figure has no value, which JSON would
+    // write as null and then not read back.
+    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.bin");
     let cache = cache.as_str();
-    if let Some(r) = std::fs::read_to_string(cache).ok().and_then(|t| serde_json::from_str(&t).ok()) {
-        eprintln!("using the run kept in {cache} (delete it to run again)");
-        return r;
+    if let Ok(bytes) = std::fs::read(cache) {
+        match bincode::deserialize::<RunSummary>(&bytes) {
+            Ok(r) => {
+                eprintln!("using the run kept in {cache} (delete it to run again)");
+                return r;
+            }
+            Err(e) => eprintln!("the run kept in {cache} does not read ({e}); running it again"),
+        }
     }
     let t0 = std::time::Instant::now();
     // Progress is kept every 0.05 s beside the cache (`.ckpt`: the simulation, `.partial`: what
@@ -64,7 +71,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
     let (ckpt, partial) = (format!("{cache}.ckpt"), format!("{cache}.partial"));
     let resumed =
         std::fs::read(&ckpt).ok().and_then(|b| fluidbed_core::sim::Simulation::restore(&b).ok()).and_then(|sim| {
-            let p: Progress = serde_json::from_str(&std::fs::read_to_string(&partial).ok()?).ok()?;
+            let p: Progress = bincode::deserialize(&std::fs::read(&partial).ok()?).ok()?;
             Some((sim, p))
         });
     let (mut sim, mut p) = match resumed {
@@ -114,7 +121,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
                 );
                 std::fs::create_dir_all("target/validate-cache").expect("cache dir");
                 write_atomically(&ckpt, &sim.checkpoint());
-                write_atomically(&partial, serde_json::to_string(&p).expect("progress").as_bytes());
+                write_atomically(&partial, &bincode::serialize(&p).expect("progress"));
             }
         }
     }
@@ -129,7 +136,10 @@ pub fn run_to(end_s: f64) -> RunSummary {
         analysis: Some(sim.analysis_report()),
     };
     std::fs::create_dir_all("target/validate-cache").expect("cache dir");
-    write_atomically(cache, serde_json::to_string(&r).unwrap().as_bytes());
+    write_atomically(cache, &bincode::serialize(&r).expect("run summary"));
+    // The checkpoint goes only once the kept run reads back.
+    let back = std::fs::read(cache).ok().and_then(|b| bincode::deserialize::<RunSummary>(&b).ok());
+    assert!(back.is_some(), "the run kept in {cache} does not read back; its checkpoint {ckpt} stays");
     let _ = (std::fs::remove_file(&ckpt), std::fs::remove_file(&partial));
     r
 }

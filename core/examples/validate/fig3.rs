@@ -7,25 +7,6 @@ use crate::common::*;
 use fluidbed_core::case::{BoxSplit, Field, Voidage};
 use serde_json::json;
 
-/// Mean |ΔU_z| between vertically and angularly adjacent cells inside the bed, over the mean U_z.
-fn roughness(s: &fluidbed_core::sim::Snapshot, uz: &[f64], k_max: usize) -> f64 {
-    let g = s.grid.grid();
-    let (mut sum, mut n, mut mean) = (0.0, 0.0, 0.0);
-    for k in 1..k_max {
-        for i in 0..g.nr {
-            for j in 0..g.cells_in_annulus(i) {
-                let c = g.index(i, j, k);
-                let (_, jn) = g.angular_neighbours(i, j);
-                sum += (uz[g.index(i, j, k + 1)] - uz[c]).abs() + (uz[g.index(i, jn, k)] - uz[c]).abs();
-                n += 2.0;
-                mean += uz[c];
-            }
-        }
-    }
-    let cells = n / 2.0;
-    (sum / n) / (mean / cells)
-}
-
 pub fn run() -> serde_json::Value {
     let methods: [(&str, Voidage); 4] = [
         ("direct", Voidage::Direct),
@@ -51,7 +32,7 @@ pub fn run() -> serde_json::Value {
         let top = bed_top_m(&sim);
         // the highest layer wholly inside the bed
         let k_bed = ((top - sim.case().particles.diameter_m) / s.grid.dz_m).floor() as usize - 1;
-        let r = roughness(s, &uz, k_bed);
+        let r = fluidbed_core::analysis::roughness(&s.grid.grid(), &uz, k_bed);
         let (_, mean_eps) = gradient_and_voidage(s, 1, k_bed);
         eprintln!("{name}: bed voidage {mean_eps:.4}, U_z roughness {r:.3}");
         crate::plots::slice(

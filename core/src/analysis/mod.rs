@@ -12,7 +12,8 @@
 //! - [`bubble_fraction`]: bubble volume fraction by height;
 //! - [`particle_average`]: particle-based time averages per cell (Boyce et al. 2013);
 //! - [`field_average`]: time averages of the cell fields (voidage, gas velocity);
-//! - [`profiles`]: radial profiles at chosen heights and azimuthal-mean maps on the axial plane.
+//! - [`profiles`]: radial profiles at chosen heights and azimuthal-mean maps on the axial plane;
+//! - [`roughness`]: the cell-to-cell jumps of a field (paper Fig. 3).
 //!
 //! The accumulators (`LayerSeries`, `BubbleFraction`, `ParticleAverage`, `FieldAverage`) are
 //! `Serialize + Deserialize` so a running job can keep them in its checkpoint; each has
@@ -26,6 +27,7 @@ pub mod layer_series;
 pub mod layers;
 pub mod particle_average;
 pub mod profiles;
+pub mod roughness;
 pub mod spectrum;
 pub mod stats;
 
@@ -37,6 +39,7 @@ pub use layer_series::LayerSeries;
 pub use layers::{bed_pressure_drop, layer_means};
 pub use particle_average::{ParticleAverage, ParticleMeans};
 pub use profiles::{axial_map, radial_profile, AxialMap, RadialProfile};
+pub use roughness::roughness;
 pub use spectrum::{dominant_frequency, welch, Spectrum};
 pub use stats::{signal_stats, SignalStats};
 
