@@ -31,8 +31,9 @@ mod tests {
         // the roughness is (2a + 0)/2 / c = a/c.
         let g = CylGrid::new(0.022, 0.044, 0.0044, 0.0044, 3);
         let (c, a) = (0.5, 0.05);
-        let f: Vec<f64> =
-            (0..g.num_cells()).map(|idx| c + if (idx / g.cells_per_layer()) % 2 == 0 { a } else { -a }).collect();
+        let f: Vec<f64> = (0..g.num_cells())
+            .map(|idx| c + if (idx / g.cells_per_layer()).is_multiple_of(2) { a } else { -a })
+            .collect();
         let r = roughness(&g, &f, 5);
         assert!((r - a / c).abs() < 1e-12, "{r}");
         let flat = vec![c; g.num_cells()];
