@@ -42,13 +42,18 @@ pub async fn run(
         eprintln!("fluidbed: running {} on {}", case.display(), api.base);
     }
     let code = submit_watch_fetch(&api, &text, &out, &formats, json_out).await;
+    stop_embedded(embedded).await;
+    code
+}
+
+/// Stop the embedded server, if one was started (its jobs checkpoint first).
+pub(crate) async fn stop_embedded(embedded: Option<Embedded>) {
     #[cfg(feature = "embedded")]
     if let Some(s) = embedded {
         let _ = tokio::task::spawn_blocking(move || s.shutdown()).await;
     }
     #[cfg(not(feature = "embedded"))]
     let _ = embedded;
-    code
 }
 
 /// Marks a folder as written by `fluidbed run`, so that a later run may replace it whole.

@@ -4,7 +4,7 @@
 //! one point per core.
 
 use crate::api::Api;
-use crate::cli_run::{fresh_out, start_embedded, Embedding};
+use crate::cli_run::{fresh_out, start_embedded, stop_embedded, Embedding};
 use crate::exit;
 use crate::outcome::{api_fail, fail};
 use fluidbed_api::{GridAxis, JobStatus, Sweep, SweepRequest};
@@ -91,12 +91,7 @@ pub async fn sweep(server: Option<Api>, token: Option<String>, args: SweepArgs, 
     };
     let req = SweepRequest { name: args.name, base, grid: Some(grid), points: None };
     let code = submit_and_follow(&api, &req, &out, json_out).await;
-    #[cfg(feature = "embedded")]
-    if let Some(s) = embedded {
-        let _ = tokio::task::spawn_blocking(move || s.shutdown()).await;
-    }
-    #[cfg(not(feature = "embedded"))]
-    let _ = embedded;
+    stop_embedded(embedded).await;
     code
 }
 

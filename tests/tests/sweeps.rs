@@ -14,6 +14,10 @@ async fn post(http: &reqwest::Client, base: &str, body: &Value) -> (u16, Value) 
     (r.status().as_u16(), r.json().await.unwrap())
 }
 
+async fn get(http: &reqwest::Client, url: &str) -> Value {
+    http.get(url).send().await.unwrap().json().await.unwrap()
+}
+
 fn pointers(problem: &Value) -> Vec<String> {
     problem["errors"].as_array().unwrap().iter().map(|e| e["pointer"].as_str().unwrap().to_string()).collect()
 }
@@ -21,7 +25,7 @@ fn pointers(problem: &Value) -> Vec<String> {
 async fn wait_sweep(http: &reqwest::Client, url: &str, timeout: Duration) -> Value {
     let t0 = Instant::now();
     loop {
-        let s: Value = http.get(url).send().await.unwrap().json().await.unwrap();
+        let s = get(http, url).await;
         let st = s["status"].as_str().unwrap();
         if !matches!(st, "queued" | "running") || t0.elapsed() > timeout {
             return s;
@@ -57,7 +61,7 @@ async fn a_sweep_runs_one_job_per_point_and_summarises_each() {
     let (code, p) = post(&http, &base, &json!({"base": case, "gird": []})).await;
     assert_eq!(code, 422, "{p}");
     assert!(p["errors"][0]["message"].as_str().unwrap().contains("gird"), "{p}");
-    let jobs: Value = http.get(format!("{base}/v1/jobs")).send().await.unwrap().json().await.unwrap();
+    let jobs = get(&http, &format!("{base}/v1/jobs")).await;
     assert_eq!(jobs["total"], 0, "a refused sweep queues nothing");
 
     // A cancelled sweep: every point ends cancelled.
@@ -83,24 +87,10 @@ async fn a_sweep_runs_one_job_per_point_and_summarises_each() {
     assert_eq!(s["status"], "succeeded", "{s}");
     for (k, (point, u)) in s["points"].as_array().unwrap().iter().zip([0.3, 0.9]).enumerate() {
         assert_eq!(point["set"][U], json!(u));
-        let job: Value = http
-            .get(format!("{base}/v1/jobs/{}", point["job"].as_str().unwrap()))
-            .send()
-            .await
-            .unwrap()
-            .json()
-            .await
-            .unwrap();
+        let job = get(&http, &format!("{base}/v1/jobs/{}", point["job"].as_str().unwrap())).await;
         assert_eq!(job["name"], format!("U sweep [{k}: superficial_velocity_m_s={u}]"));
         // The summary against the job's own pressure-drop series over t ≥ end / 2.
-        let list: Value = http
-            .get(format!("{base}/v1/jobs/{}/snapshots", job["id"].as_str().unwrap()))
-            .send()
-            .await
-            .unwrap()
-            .json()
-            .await
-            .unwrap();
+        let list = get(&http, &format!("{base}/v1/jobs/{}/snapshots", job["id"].as_str().unwrap())).await;
         let window: Vec<f64> = list["snapshots"]
             .as_array()
             .unwrap()
@@ -119,7 +109,7 @@ async fn a_sweep_runs_one_job_per_point_and_summarises_each() {
         assert_eq!(sm["superficial_velocity_m_s"], json!(u));
         assert!(sm["pressure_drop_std_pa"].as_f64().unwrap() >= 0.0);
     }
-    let list: Value = http.get(format!("{base}/v1/sweeps")).send().await.unwrap().json().await.unwrap();
+    let list = get(&http, &format!("{base}/v1/sweeps")).await;
     assert_eq!(list["total"], 2);
     assert_eq!(list["sweeps"][0]["name"], "U sweep", "newest first");
     assert_eq!(http.get(format!("{base}/v1/sweeps/0123456789abcdef")).send().await.unwrap().status(), 404);
@@ -133,18 +123,11 @@ fn the_sweep_command_prints_and_writes_a_summary_table() {
     std::fs::write(&case, small_bubbling_case("cli sweep", 0.006, 0.001).to_string()).unwrap();
     let out = dir.path().join("out");
     let url = server.url();
-    let code = fluidbed::cli::main_with([
-        "fluidbed",
-        "--server",
-        url.as_str(),
-        "sweep",
-        case.to_str().unwrap(),
-        "--set",
-        "/gas/superficial_velocity_m_s=0.6:0.8:0.2",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_eq!(code, fluidbed::exit::OK);
+    let sweep_with = |set: &str, out: &std::path::Path| {
+        let args = ["--server", &url, "sweep", case.to_str().unwrap(), "--set", set, "--out", out.to_str().unwrap()];
+        fluidbed::cli::main_with(std::iter::once("fluidbed").chain(args))
+    };
+    assert_eq!(sweep_with("/gas/superficial_velocity_m_s=0.6:0.8:0.2", &out), fluidbed::exit::OK);
     let csv = std::fs::read_to_string(out.join("summary.csv")).unwrap();
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 3, "{csv}");
@@ -154,14 +137,5 @@ fn the_sweep_command_prints_and_writes_a_summary_table() {
     let sweep: Value = serde_json::from_str(&std::fs::read_to_string(out.join("sweep.json")).unwrap()).unwrap();
     assert_eq!(sweep["status"], "succeeded");
     // A bad --set is a usage error before anything is sent.
-    let bad = fluidbed::cli::main_with([
-        "fluidbed",
-        "--server",
-        url.as_str(),
-        "sweep",
-        case.to_str().unwrap(),
-        "--set",
-        "gas=1",
-    ]);
-    assert_eq!(bad, fluidbed::exit::USAGE);
+    assert_eq!(sweep_with("gas=1", &dir.path().join("bad")), fluidbed::exit::USAGE);
 }

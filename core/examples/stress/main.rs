@@ -2,9 +2,12 @@
 //! `extremes [CASES] [SEED]`: seeded random cases inside and beyond the schema's ranges; prints a
 //! line per case, the outcome table, one stop message per kind, and last one JSON line.
 //! `dt-sweep`: the largest stable DEM and gas steps by bisection, beside the theoretical limits.
+//! `packed-100k`: the packed bed, particles free, 100,000 steps per voidage method: jumps and
+//! temporal fluctuation of the gas velocity.
 
 mod dt_sweep;
 mod extremes;
+mod packed_100k;
 
 use std::time::Duration;
 
@@ -28,8 +31,9 @@ fn main() {
             }
         }
         Some("dt-sweep") => dt_sweep::run(),
+        Some("packed-100k") => packed_100k::run(),
         other => {
-            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep (got {other:?})");
+            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep | packed-100k (got {other:?})");
             std::process::exit(2);
         }
     }

@@ -4,19 +4,11 @@
 //! vertical gas velocity (and one of voidage) per method.
 
 use crate::common::*;
-use fluidbed_core::case::{BoxSplit, Field, Voidage};
+use fluidbed_core::case::{Field, Voidage};
 use serde_json::json;
 
 pub fn run() -> serde_json::Value {
-    let methods: [(&str, Voidage); 4] = [
-        ("direct", Voidage::Direct),
-        ("grouping", Voidage::Grouping),
-        (
-            "square_grid",
-            Voidage::SquareGrid { box_side_m: Some(0.001375), split: BoxSplit::Cuboid, cube_side_factor: 1.0 },
-        ),
-        ("exact_cylindrical", Voidage::ExactCylindrical),
-    ];
+    let methods = Voidage::fig3_methods();
     let mut out = serde_json::Map::new();
     let mut eps_of = std::collections::BTreeMap::new();
     for (name, method) in methods {

@@ -432,6 +432,23 @@ impl Default for Voidage {
     }
 }
 
+impl Voidage {
+    /// The methods of the paper's Fig. 3, by name, and the exact split beside them: direct,
+    /// grouping, the square grid of configuration 3 for d = 1.2 mm (1.375-mm boxes, cuboid split),
+    /// exact_cylindrical.
+    pub fn fig3_methods() -> [(&'static str, Voidage); 4] {
+        [
+            ("direct", Voidage::Direct),
+            ("grouping", Voidage::Grouping),
+            (
+                "square_grid",
+                Voidage::SquareGrid { box_side_m: Some(0.001375), split: BoxSplit::Cuboid, cube_side_factor: 1.0 },
+            ),
+            ("exact_cylindrical", Voidage::ExactCylindrical),
+        ]
+    }
+}
+
 impl Case {
     /// Parse JSON (serde errors name the line and column).
     pub fn from_json(s: &str) -> Result<Case, serde_json::Error> {

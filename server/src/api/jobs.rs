@@ -213,17 +213,10 @@ pub(super) fn invalid_case(errors: &[Problem], warnings: &[Problem]) -> Response
     )
 )]
 pub async fn list(State(app): State<Arc<App>>, Query(q): Query<ListQuery>) -> Response {
-    let (limit, offset) = (q.limit.unwrap_or(50), q.offset.unwrap_or(0));
-    if !(1..=MAX_LIMIT).contains(&limit) {
-        return problem(StatusCode::BAD_REQUEST, "Bad limit", &format!("limit is from 1 to {MAX_LIMIT} (got {limit})"));
-    }
-    if offset > MAX_OFFSET {
-        return problem(
-            StatusCode::BAD_REQUEST,
-            "Bad offset",
-            &format!("offset is from 0 to {MAX_OFFSET} (got {offset})"),
-        );
-    }
+    let (limit, offset) = match page(q.limit, q.offset) {
+        Ok(p) => p,
+        Err(r) => return r,
+    };
     match app.store.list(q.status, limit as usize, offset as usize) {
         Ok((jobs, total)) => {
             let end = offset + jobs.len() as u64;
@@ -239,6 +232,21 @@ pub async fn list(State(app): State<Arc<App>>, Query(q): Query<ListQuery>) -> Re
         }
         Err(e) => internal(e),
     }
+}
+
+/// A list page's limit (default 50, 1 to MAX_LIMIT) and offset (default 0, to MAX_OFFSET), or 400.
+#[allow(clippy::result_large_err)]
+pub(super) fn page(limit: Option<u64>, offset: Option<u64>) -> Result<(u64, u64), Response> {
+    let (limit, offset) = (limit.unwrap_or(50), offset.unwrap_or(0));
+    if !(1..=MAX_LIMIT).contains(&limit) {
+        let d = format!("limit is from 1 to {MAX_LIMIT} (got {limit})");
+        return Err(problem(StatusCode::BAD_REQUEST, "Bad limit", &d));
+    }
+    if offset > MAX_OFFSET {
+        let d = format!("offset is from 0 to {MAX_OFFSET} (got {offset})");
+        return Err(problem(StatusCode::BAD_REQUEST, "Bad offset", &d));
+    }
+    Ok((limit, offset))
 }
 
 /// The job, or the response to send instead (404 / 500); handlers return it as is.

@@ -3,7 +3,7 @@
 // The helpers return the answer to send as their error (a `Response`, large by design).
 #![allow(clippy::result_large_err)]
 
-use super::jobs::{cancel_job, invalid_case, new_job, queue_room, read_json};
+use super::jobs::{cancel_job, invalid_case, new_job, page, queue_room, read_json};
 use super::problem::{internal, problem};
 use crate::job::{new_id, now_rfc3339, plausible_id, Job, Status};
 use crate::store::SweepRecord;
@@ -15,7 +15,6 @@ use axum::extract::{Path, Query, State};
 use axum::http::{header, HeaderMap, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use fluidbed_api::query::{MAX_LIMIT, MAX_OFFSET};
 use fluidbed_api::{PageQuery, Sweep, SweepList, SweepPoint, SweepRequest};
 use fluidbed_core::case::bounds::CaseSize;
 use fluidbed_core::case::{Case, Problem, Severity};
@@ -297,14 +296,10 @@ pub async fn get_one(State(app): State<Arc<App>>, Path(id): Path<String>) -> Res
     )
 )]
 pub async fn list(State(app): State<Arc<App>>, Query(q): Query<PageQuery>) -> Response {
-    let (limit, offset) = (q.limit.unwrap_or(50), q.offset.unwrap_or(0));
-    if !(1..=MAX_LIMIT).contains(&limit) {
-        return problem(StatusCode::BAD_REQUEST, "Bad limit", &format!("limit is from 1 to {MAX_LIMIT} (got {limit})"));
-    }
-    if offset > MAX_OFFSET {
-        let d = format!("offset is from 0 to {MAX_OFFSET} (got {offset})");
-        return problem(StatusCode::BAD_REQUEST, "Bad offset", &d);
-    }
+    let (limit, offset) = match page(q.limit, q.offset) {
+        Ok(p) => p,
+        Err(r) => return r,
+    };
     let a = app.clone();
     let out = tokio::task::spawn_blocking(move || -> anyhow::Result<SweepList> {
         let (records, total) = a.store.sweeps(limit as usize, offset as usize)?;
