@@ -79,7 +79,7 @@ impl Plan {
         if self.gas && !self.coupling {
             out.push("voidage, drag and exchange: no particles".into());
         } else if self.coupling && !self.particles_move {
-            out.push("voidage and per-particle drag: computed once for the frozen bed (O(cells) exchange)".into());
+            out.push("voidage and drag per particle: the frozen bed's voidage is computed once and the exchange per cell (O(cells))".into());
         } else if self.coupling && self.coupling_interval > 1 {
             out.push(format!(
                 "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), held in between",

@@ -80,9 +80,10 @@ fn cases_of(app: &App, req: &SweepRequest) -> Result<(String, Vec<Ready>), Respo
                 if let Some(p) = CaseSize::of(&case).memory_problem(&case, app.config.max_job_memory) {
                     errors.push(locate(p, k, &point));
                 }
-                for w in &report.warnings {
-                    if !warnings.iter().any(|seen| seen.path == w.path) {
-                        warnings.push(locate(w.clone(), k, &point));
+                // Each warning once, by where it is named (the base's warnings hold for every point).
+                for w in report.warnings.iter().map(|w| locate(w.clone(), k, &point)) {
+                    if !warnings.iter().any(|seen: &Problem| seen.path == w.path) {
+                        warnings.push(w);
                     }
                 }
                 let text = serde_json::to_string(&case).map_err(|e| internal(e.into()))?;
