@@ -4,9 +4,11 @@
 //! `dt-sweep`: the largest stable DEM and gas steps by bisection, beside the theoretical limits.
 //! `packed-100k`: the packed bed, particles free, 100,000 steps per voidage method: jumps and
 //! temporal fluctuation of the gas velocity.
+//! `gas-artefacts`: the freeboard's odd–even pressure ripple and the outlet's pressure offset.
 
 mod dt_sweep;
 mod extremes;
+mod gas_artefacts;
 mod packed_100k;
 
 use std::time::Duration;
@@ -32,8 +34,9 @@ fn main() {
         }
         Some("dt-sweep") => dt_sweep::run(),
         Some("packed-100k") => packed_100k::run(),
+        Some("gas-artefacts") => gas_artefacts::run(),
         other => {
-            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep | packed-100k (got {other:?})");
+            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep | packed-100k | gas-artefacts (got {other:?})");
             std::process::exit(2);
         }
     }
