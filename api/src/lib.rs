@@ -17,7 +17,8 @@ pub use health::{DataDirReport, Health, HealthStatus};
 pub use job::{CaseProblem, Job, JobLinks, JobList, JobStatus, Severity};
 pub use problem::{FieldError, Problem};
 pub use query::{
-    EventsQuery, ListQuery, PageQuery, SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery,
+    AnalysisQuery, EventsQuery, ListQuery, PageQuery, SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat,
+    SnapshotQuery,
 };
 pub use snapshot::{Binary, GridInfo, ParticleState, PressureDropSeries, SnapshotDocument, SnapshotInfo, SnapshotList};
 pub use sweep::{GridAxis, PointSummary, Sweep, SweepList, SweepPoint, SweepRequest};

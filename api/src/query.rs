@@ -120,6 +120,17 @@ pub struct SeriesQuery {
     pub format: Option<SeriesFormat>,
 }
 
+/// `GET /v1/jobs/{id}/analysis` and its figures.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, IntoParams)]
+#[into_params(parameter_in = Query)]
+pub struct AnalysisQuery {
+    /// Simulated time (s) from which the time-series statistics (ΔP, bubble count, rise velocity)
+    /// are taken; the maps and profiles keep the whole accumulated window (default: all of it).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    #[param(minimum = 0)]
+    pub from: Option<f64>,
+}
+
 /// `GET /v1/jobs/{id}/events`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, IntoParams)]
 #[into_params(parameter_in = Query)]

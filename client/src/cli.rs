@@ -64,6 +64,10 @@ enum Verb {
         /// Output folder (default ./fluidbed-out/<job id>/).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Take the ΔP statistics, bubble count and rise velocity from this simulated time (s);
+        /// the maps and profiles keep the whole window of the case's `analysis`.
+        #[arg(long, value_name = "T")]
+        from: Option<f64>,
     },
     /// Cancel a job.
     Cancel { id: String },
@@ -142,6 +146,9 @@ fn print_job(j: &Job, json_out: bool) {
 fn print_analysis(a: &serde_json::Value) {
     let num = |v: &serde_json::Value| v.as_f64().map(|x| format!("{x:.4}")).unwrap_or_else(|| "—".into());
     println!("window {} – {} s, {} samples", num(&a["from_s"]), num(&a["to_s"]), a["samples"]);
+    if a["series_samples"] != a["samples"] {
+        println!("ΔP, bubbles and rise velocity from {} s, {} samples", num(&a["series_from_s"]), a["series_samples"]);
+    }
     let dp = &a["pressure_drop"];
     println!(
         "ΔP mean {} Pa, std {} Pa, dominant frequency {} Hz",
@@ -259,9 +266,12 @@ async fn dispatch(cli: Cli) -> i32 {
                 Err(e) => api_fail(e, j),
             }
         }
-        Verb::Analyze { id, out } => {
+        Verb::Analyze { id, out, from } => {
+            if from.is_some_and(|t| !(t.is_finite() && t >= 0.0)) {
+                return fail(exit::USAGE, "--from must be a simulated time ≥ 0 s");
+            }
             let out = out.unwrap_or_else(|| PathBuf::from("fluidbed-out").join(&id));
-            match fetch_analysis(&api, &id, &out).await {
+            match fetch_analysis(&api, &id, &out, from).await {
                 Ok(files) if files.is_empty() => {
                     fail(exit::SERVER, &format!("job {id} has no analysis yet (no checkpoint written)"))
                 }

@@ -110,7 +110,7 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
             save(if has_dp { "pressure_drop.png" } else { "mean_particle_height.png" }.into(), b)?;
         }
     }
-    files.extend(fetch_analysis(api, id, out).await?);
+    files.extend(fetch_analysis(api, id, out, None).await?);
     Ok(files)
 }
 
@@ -120,17 +120,19 @@ const ANALYSIS_FIGURES: [&str; 4] =
 
 /// The job's analysis into `out`: `analysis.json` and the figures it has samples for (a figure
 /// without enough samples, or a job without a checkpoint yet, is skipped).
-pub async fn fetch_analysis(api: &Api, id: &str, out: &Path) -> Result<Vec<PathBuf>, ApiError> {
+/// The analysis and its figures into `out`; `from_s` starts the time-series statistics later.
+pub async fn fetch_analysis(api: &Api, id: &str, out: &Path, from_s: Option<f64>) -> Result<Vec<PathBuf>, ApiError> {
+    let q = fluidbed_api::AnalysisQuery { from: from_s };
     std::fs::create_dir_all(out).map_err(|e| ApiError::Server(format!("cannot create {}: {e}", out.display())))?;
     let base = format!("/v1/jobs/{id}/analysis");
     let mut files = Vec::new();
-    let Some(json) = api.get_bytes(&base, &()).await? else {
+    let Some(json) = api.get_bytes(&base, &q).await? else {
         return Ok(files);
     };
     for (name, bytes) in std::iter::once(("analysis.json".to_string(), Some(json))).chain({
         let mut figs = Vec::new();
         for f in ANALYSIS_FIGURES {
-            figs.push((f.to_string(), api.get_bytes(&format!("{base}/{f}"), &()).await?));
+            figs.push((f.to_string(), api.get_bytes(&format!("{base}/{f}"), &q).await?));
         }
         figs
     }) {

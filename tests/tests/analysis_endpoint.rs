@@ -1,7 +1,8 @@
 //! The run's analysis through the service: accumulated while the job runs, read from its last
 //! checkpoint. Its samples here fall on the snapshot times, so its ΔP mean and spread must be
 //! those of the stored pressure-drop series over the same window (two paths to one number); its
-//! figures are PNGs, and an unknown figure is a problem document.
+//! figures are PNGs, and an unknown figure is a problem document. `?from=T` takes the time-series
+//! statistics from T on.
 
 use fluidbed_tests::*;
 use serde_json::{json, Value};
@@ -39,6 +40,19 @@ async fn analysis_of_a_finished_job_matches_its_pressure_series_and_draws_its_fi
     assert!((got - mean).abs() <= 1e-9 * mean.abs(), "analysis ΔP mean {got} vs the series' {mean}");
     assert!(a["pressure_drop"]["std_pa"].as_f64().unwrap() > 0.0);
     assert!(!a["voidage_map"]["value"].as_array().unwrap().is_empty());
+
+    // From 24 ms: the ΔP statistics of the five snapshots 24 … 40 ms, the maps unchanged.
+    let late: Value = http.get(format!("{url}/analysis?from=0.024")).send().await.unwrap().json().await.unwrap();
+    let tail = &dp[4..];
+    let mean = tail.iter().sum::<f64>() / tail.len() as f64;
+    let got = late["pressure_drop"]["mean_pa"].as_f64().unwrap();
+    assert!((got - mean).abs() <= 1e-9 * mean.abs(), "ΔP mean from 24 ms {got} vs the series' {mean}");
+    assert_eq!((late["series_samples"].as_u64(), late["samples"].as_u64()), (Some(5), Some(9)), "{late}");
+    assert!((late["series_from_s"].as_f64().unwrap() - 0.024).abs() < 1e-9);
+    assert_eq!(late["voidage_map"], a["voidage_map"]);
+    let r = http.get(format!("{url}/analysis?from=-1")).send().await.unwrap();
+    assert_eq!(r.status(), 400);
+    assert!(r.text().await.unwrap().contains("`from`"));
 
     for figure in ["pressure_spectrum.png", "voidage_map.png", "particle_velocity_map.png"] {
         let r = http.get(format!("{url}/analysis/{figure}")).send().await.unwrap();

@@ -212,11 +212,14 @@ impl Simulation {
     }
 
     /// The analysis held in a checkpoint (`checkpoint`), read without restoring the run: the
-    /// case's grid and the report of its samples.
-    pub fn analysis_of_checkpoint(bytes: &[u8]) -> Result<(Case, CylGrid, AnalysisReport), SimError> {
+    /// case's grid and the report of its samples (time series from `series_from_s` when given).
+    pub fn analysis_of_checkpoint(
+        bytes: &[u8],
+        series_from_s: Option<f64>,
+    ) -> Result<(Case, CylGrid, AnalysisReport), SimError> {
         let (case, analysis) = checkpoint::analysis_of(bytes).map_err(SimError::Checkpoint)?;
         let grid = fluid_grid(&case);
-        let report = analysis.report(&grid);
+        let report = analysis.report_from(&grid, series_from_s);
         Ok((case, grid, report))
     }
 

@@ -56,6 +56,10 @@ pub struct AnalysisReport {
     pub from_s: f64,
     pub to_s: f64,
     pub samples: u64,
+    /// Start and sample count of the window of the time-series statistics (ΔP, bubble count, rise
+    /// velocity): `from_s` and `samples` unless the request asked for a later start.
+    pub series_from_s: f64,
+    pub series_samples: u64,
     pub sample_interval_s: f64,
     pub pressure_drop: Option<PressureDropStats>,
     /// Top of the highest layer whose time-averaged voidage is below 0.8 (m).
@@ -140,9 +144,20 @@ impl RunAnalysis {
     }
 
     pub fn report(&self, grid: &CylGrid) -> AnalysisReport {
+        self.report_from(grid, None)
+    }
+
+    /// The report with the time series (ΔP statistics and spectrum, bubble count, rise velocity)
+    /// over the samples at or after `from_s` only; the maps, profiles, bubble fraction and bed
+    /// height are sums and keep the whole window (`from_s`–`to_s` of the report).
+    pub fn report_from(&self, grid: &CylGrid, from_s: Option<f64>) -> AnalysisReport {
         let dt = self.every_s();
-        let pressure_drop = signal_stats(&self.pressure_drop_pa).map(|st| {
-            let spectrum = welch_of(&self.pressure_drop_pa, dt);
+        let times = self.voidage_layers.times_s();
+        let skip = from_s.map_or(0, |t| times.partition_point(|&x| x < t - 1e-12));
+        let series_from_s = times.get(skip).copied().unwrap_or(self.last_s);
+        let dp = &self.pressure_drop_pa[skip.min(self.pressure_drop_pa.len())..];
+        let pressure_drop = signal_stats(dp).map(|st| {
+            let spectrum = welch_of(dp, dt);
             PressureDropStats {
                 mean_pa: st.mean,
                 std_pa: st.std,
@@ -161,17 +176,13 @@ impl RunAnalysis {
             .flatten()
             .map(|k| (k + 1) as f64 * grid.dz);
         let rise_heights = self.spec.rise_heights_m.or(bed_height_m.map(|h| [0.3 * h, 0.7 * h]));
-        let bubbles = rise_heights.and_then(|[lo, _]| self.bubbles_at(lo, dt));
+        let bubbles = rise_heights.and_then(|[lo, _]| self.bubbles_at(lo, dt, skip));
         let rise_velocity = rise_heights.map(|[lo, hi]| {
-            let (a, b) = (self.voidage_layers.at_height(lo), self.voidage_layers.at_height(hi));
+            let (a, b) = (&self.voidage_layers.at_height(lo)[skip..], &self.voidage_layers.at_height(hi)[skip..]);
             let (klo, khi) = (grid.locate_k(lo), grid.locate_k(hi));
             let dz = (khi as f64 - klo as f64) * grid.dz;
             let half = 0.5 * a.len() as f64 * dt;
-            Rise {
-                lower_m: lo,
-                upper_m: hi,
-                voidage: (dz > 0.0).then(|| rise_velocity(&a, &b, dt, dz, half)).flatten(),
-            }
+            Rise { lower_m: lo, upper_m: hi, voidage: (dz > 0.0).then(|| rise_velocity(a, b, dt, dz, half)).flatten() }
         });
         let heights = if self.spec.profile_heights_m.is_empty() {
             bed_height_m.map(|h| vec![0.5 * h]).unwrap_or_default()
@@ -190,6 +201,8 @@ impl RunAnalysis {
             from_s: self.first_s.unwrap_or(self.spec.from_s),
             to_s: self.last_s,
             samples: self.samples(),
+            series_from_s,
+            series_samples: (times.len() - skip) as u64,
             sample_interval_s: dt,
             pressure_drop,
             bed_height_m,
@@ -210,8 +223,8 @@ impl RunAnalysis {
         }
     }
 
-    fn bubbles_at(&self, z: f64, dt: f64) -> Option<Bubbles> {
-        let x = self.voidage_layers.at_height(z);
+    fn bubbles_at(&self, z: f64, dt: f64, skip: usize) -> Option<Bubbles> {
+        let x = self.voidage_layers.at_height(z).split_off(skip);
         let st = signal_stats(&x)?;
         let (rise, fall) = (st.mean + st.std, st.mean);
         (rise > fall).then(|| Bubbles { height_m: z, rise, fall, count: count_bubbles(&x, dt, rise, fall) })
@@ -231,6 +244,58 @@ fn welch_of(x: &[f64], dt: f64) -> Option<Spectrum> {
 mod tests {
     use super::*;
     use std::f64::consts::PI;
+
+    /// A ΔP of 100 + 10 sin(2π·4 t) Pa before 0.5 s and 200 + 20 sin(2π·10 t) Pa after: the report
+    /// from 0.5 s has the second signal's statistics, the whole report their mixture.
+    #[test]
+    fn a_later_start_gives_the_time_series_statistics_of_that_window_only() {
+        let case: Case = serde_json::from_str(
+            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
+               "dem":{"time_step_s":1e-3},"analysis":{"from_s":0.0,"sample_interval_s":0.001}}"#,
+        )
+        .unwrap();
+        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
+        let mut a = RunAnalysis::new(&case, &grid);
+        let (n, per) = (grid.num_cells(), grid.cells_per_layer());
+        let eps = vec![0.4; n];
+        let none: Vec<[f64; 3]> = vec![];
+        for step in 0..1000u64 {
+            let t = step as f64 * 1e-3;
+            let dp = if t < 0.5 {
+                100.0 + 10.0 * (2.0 * PI * 4.0 * t).sin()
+            } else {
+                200.0 + 20.0 * (2.0 * PI * 10.0 * t).sin()
+            };
+            let slope = dp / (grid.nz as f64 - 1.0);
+            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
+            let s = Sample {
+                time_s: t,
+                voidage: &eps,
+                pressure_pa: Some(&p),
+                gas_velocity: None,
+                positions: &none,
+                velocities: &none,
+            };
+            a.add(&grid, &s);
+        }
+        let late = a.report_from(&grid, Some(0.5));
+        assert_eq!((late.series_samples, late.samples), (500, 1000));
+        assert!(
+            (late.series_from_s - 0.5).abs() < 1e-12 && late.from_s == 0.0,
+            "window {} / {}",
+            late.series_from_s,
+            late.from_s
+        );
+        let dp = late.pressure_drop.as_ref().unwrap();
+        assert!((dp.mean_pa - 200.0).abs() < 0.01, "mean {}", dp.mean_pa);
+        assert!((dp.std_pa / (20.0 / 2f64.sqrt()) - 1.0).abs() < 0.01, "std {}", dp.std_pa);
+        let f = dp.dominant_frequency_hz.unwrap();
+        assert!((f - 10.0).abs() <= dp.spectrum.as_ref().unwrap().df_hz, "dominant {f} Hz");
+        let all = a.report(&grid);
+        assert_eq!((all.series_samples, all.series_from_s), (1000, 0.0));
+        assert!((all.pressure_drop.unwrap().mean_pa - 150.0).abs() < 0.01);
+        assert_eq!(late.voidage_map.value, all.voidage_map.value, "the maps keep the whole window");
+    }
 
     /// Synthetic samples whose statistics are known: a bed of ε = 0.4 below 12 mm (ε = 1 above,
     /// a bubble of ε = 0.9 in the lower layers every 0.1 s), a pressure field whose bed drop is

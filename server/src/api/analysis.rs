@@ -5,10 +5,11 @@
 use super::jobs::find;
 use super::problem::{internal, problem};
 use crate::App;
-use axum::extract::{Path, State};
+use axum::extract::{Path, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
+use fluidbed_api::AnalysisQuery;
 use fluidbed_core::grid::CylGrid;
 use fluidbed_core::output::plot;
 use fluidbed_core::sim::{AnalysisReport, Simulation};
@@ -19,7 +20,11 @@ const FIGURES: [&str; 4] =
     ["pressure_spectrum.png", "rise_correlation.png", "particle_velocity_map.png", "voidage_map.png"];
 
 /// The report of the job's last checkpoint, or the problem to answer with.
-async fn report(app: &Arc<App>, id: &str) -> Result<(CylGrid, AnalysisReport, String), Response> {
+async fn report(app: &Arc<App>, id: &str, q: &AnalysisQuery) -> Result<(CylGrid, AnalysisReport, String), Response> {
+    let from = q.from;
+    if from.is_some_and(|t| !(t.is_finite() && t >= 0.0)) {
+        return Err(problem(StatusCode::BAD_REQUEST, "Bad query", "`from` must be a finite time ≥ 0 s"));
+    }
     let job = find(app, id)?;
     let a = app.clone();
     let job_id = id.to_string();
@@ -35,7 +40,7 @@ async fn report(app: &Arc<App>, id: &str) -> Result<(CylGrid, AnalysisReport, St
         Ok(Err(e)) => return Err(internal(e)),
         Err(e) => return Err(internal(e.into())),
     };
-    match tokio::task::spawn_blocking(move || Simulation::analysis_of_checkpoint(&bytes)).await {
+    match tokio::task::spawn_blocking(move || Simulation::analysis_of_checkpoint(&bytes, from)).await {
         Ok(Ok((_, grid, r))) => Ok((grid, r, job.name)),
         Ok(Err(e)) => Err(internal(anyhow::anyhow!("{e}"))),
         Err(e) => Err(internal(e.into())),
@@ -51,15 +56,17 @@ async fn report(app: &Arc<App>, id: &str) -> Result<(CylGrid, AnalysisReport, St
     path = "/v1/jobs/{id}/analysis",
     operation_id = "get_analysis",
     tag = "results",
-    params(("id" = String, Path, description = "The job id")),
+    params(("id" = String, Path, description = "The job id"), AnalysisQuery),
     responses(
         (status = 200, description = "The analysis as of the job's last checkpoint", body = Object),
+        (status = 400, description = "A bad query string", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
         (status = 404, description = "No such job, or no checkpoint yet", body = fluidbed_api::Problem,
             content_type = "application/problem+json"),
     )
 )]
-pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>) -> Response {
-    match report(&app, &id).await {
+pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>, Query(q): Query<AnalysisQuery>) -> Response {
+    match report(&app, &id, &q).await {
         Ok((_, r, _)) => Json(r).into_response(),
         Err(r) => r,
     }
@@ -77,14 +84,21 @@ pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>) -> Respons
     params(
         ("id" = String, Path, description = "The job id"),
         ("figure" = String, Path, description = "pressure_spectrum.png, rise_correlation.png, particle_velocity_map.png or voidage_map.png"),
+        AnalysisQuery,
     ),
     responses(
         (status = 200, description = "The figure", body = fluidbed_api::Binary, content_type = "image/png"),
+        (status = 400, description = "A bad query string", body = fluidbed_api::Problem,
+            content_type = "application/problem+json"),
         (status = 404, description = "No such job or figure, no checkpoint yet, or too few samples for it",
             body = fluidbed_api::Problem, content_type = "application/problem+json"),
     )
 )]
-pub async fn figure(State(app): State<Arc<App>>, Path((id, figure)): Path<(String, String)>) -> Response {
+pub async fn figure(
+    State(app): State<Arc<App>>,
+    Path((id, figure)): Path<(String, String)>,
+    Query(q): Query<AnalysisQuery>,
+) -> Response {
     if !FIGURES.contains(&figure.as_str()) {
         return problem(
             StatusCode::NOT_FOUND,
@@ -92,7 +106,7 @@ pub async fn figure(State(app): State<Arc<App>>, Path((id, figure)): Path<(Strin
             &format!("no such figure; the figures are {}", FIGURES.join(", ")),
         );
     }
-    let (grid, r, name) = match report(&app, &id).await {
+    let (grid, r, name) = match report(&app, &id, &q).await {
         Ok(x) => x,
         Err(r) => return r,
     };
@@ -104,13 +118,14 @@ pub async fn figure(State(app): State<Arc<App>>, Path((id, figure)): Path<(Strin
 
 fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Response {
     let window = format!("{:.3}–{:.3} s, {} samples", r.from_s, r.to_s, r.samples);
+    let series = format!("{:.3}–{:.3} s, {} samples", r.series_from_s, r.to_s, r.series_samples);
     let too_few = |what: &str| problem(StatusCode::NOT_FOUND, "Not enough samples", &format!("{what} ({window})"));
     let image = match figure {
         "pressure_spectrum.png" => {
             let Some(s) = r.pressure_drop.as_ref().and_then(|p| p.spectrum.as_ref()) else {
                 return too_few("no ΔP spectrum yet: a gas run needs at least 8 samples");
             };
-            let title = format!("{job_name}: ΔP spectrum, {window}");
+            let title = format!("{job_name}: ΔP spectrum, {series}");
             let labels =
                 plot::TraceLabels { title: &title, x: "frequency f [Hz]", y: "power spectral density [Pa²/Hz]" };
             plot::trace(&s.freq_hz, &s.psd, &labels)
@@ -121,7 +136,7 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
             };
             let lag: Vec<f64> = (0..v.correlation.len()).map(|k| k as f64 * v.dt_s).collect();
             let title = format!(
-                "{job_name}: voidage correlation {:.0}–{:.0} mm, u = {:.3} m/s, {window}",
+                "{job_name}: voidage correlation {:.0}–{:.0} mm, u = {:.3} m/s, {series}",
                 1e3 * rise.lower_m,
                 1e3 * rise.upper_m,
                 v.velocity_m_s
