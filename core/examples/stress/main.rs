@@ -5,7 +5,10 @@
 //! `packed-100k`: the packed bed, particles free, 100,000 steps per voidage method: jumps and
 //! temporal fluctuation of the gas velocity.
 //! `gas-artefacts`: the freeboard's odd–even pressure ripple and the outlet's pressure offset.
+//! `bubbling-1m`: the 44-mm bubbling bed for 1,000,000 DEM steps: gas mass and particle momentum
+//! budgets, no watchdog stop.
 
+mod bubbling_1m;
 mod dt_sweep;
 mod extremes;
 mod gas_artefacts;
@@ -35,8 +38,9 @@ fn main() {
         Some("dt-sweep") => dt_sweep::run(),
         Some("packed-100k") => packed_100k::run(),
         Some("gas-artefacts") => gas_artefacts::run(),
+        Some("bubbling-1m") => bubbling_1m::run(),
         other => {
-            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep | packed-100k | gas-artefacts (got {other:?})");
+            eprintln!("usage: stress extremes [CASES] [SEED] | dt-sweep | packed-100k | gas-artefacts | bubbling-1m (got {other:?})");
             std::process::exit(2);
         }
     }

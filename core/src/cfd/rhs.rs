@@ -257,6 +257,29 @@ pub fn face_flux_rate(eps_f: f64, rho_f: f64, beta_f: f64, mismatch: f64, delta:
     -s0a * (eps_f * mismatch * d + beta_f * f * delta) / (delta * (d * a + beta_f * delta))
 }
 
+/// Mass flux (kg/s) into cell i of the bottom layer through the inlet: ṁ = ρ_f·U(t)·A_z, with the
+/// face density of the hydrostatic ghost.
+#[inline]
+pub fn inlet_mass_flux(inp: &RhsInput, p: &[f64], i: usize) -> f64 {
+    let (par, a2) = (inp.params, inp.params.sound_speed * inp.params.sound_speed);
+    let (_, u_in) = inp.inlet();
+    let rho_f = inlet_face_pressure(p[i], (inp.nz > 1).then(|| p[i + inp.per]), par.gravity, inp.dz, a2) / a2;
+    rho_f * u_in * inp.geo.area_z
+}
+
+/// ṁ_in − ṁ_out (kg/s) of the flux-updated cells (mass_budget.rs) at the right-hand side whose
+/// pressures are `p` and axial faces `axial`: the inlet, less the faces into the characteristic
+/// outlet layer (a shut top has none).
+pub fn net_mass_inflow(inp: &RhsInput, p: &[f64], axial: &[[f64; 7]]) -> f64 {
+    let per = inp.per;
+    let inflow: f64 = (0..per).map(|c| inlet_mass_flux(inp, p, c)).sum();
+    if inp.params.outlet == Outlet::Characteristic && inp.nz > 1 {
+        inflow - axial[(inp.nz - 2) * per..(inp.nz - 1) * per].iter().map(|f| f[0]).sum::<f64>()
+    } else {
+        inflow
+    }
+}
+
 /// Fluxes across the axial face between cell `lo` (layer kl) and the cell above it: the convective
 /// flux upward [ṁ, ṁu_x, ṁu_y, ṁu_z], the viscous force on `lo` and dF/dt of the face.
 #[inline]
@@ -372,7 +395,7 @@ pub fn residual_layer(
         }
     }
     // Axial faces: bottom and top of this layer (each computed identically by both layers).
-    let (w_in, u_in) = inp.inlet();
+    let (w_in, _) = inp.inlet();
     for c in 0..per {
         let i = base + c;
         let e = inp.eps[i] * inv_v;
@@ -380,8 +403,7 @@ pub fn residual_layer(
         if k == 0 {
             // Inlet: ṁ = ρ_f·U(t)·A_z with the face density of the hydrostatic ghost, momentum
             // flux ṁ·U(t)/ε_in (vertical only), no viscous flux.
-            let rho_f = inlet_face_pressure(pr.p[i], (inp.nz > 1).then(|| pr.p[i + per]), par.gravity, inp.dz, a2) / a2;
-            let m_in = rho_f * u_in * geo.area_z;
+            let m_in = inlet_mass_flux(inp, pr.p, i);
             r[0] += m_in * inv_v;
             r[3] += m_in * w_in * inv_v;
         } else {

@@ -4,10 +4,11 @@
 use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::{outlet_layer, OutletGeometry};
 use super::geometry::FaceGeometry;
+use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet};
 use super::rhs::{
-    axial_layer, gradients_layer, inlet_face_pressure, primitives_layer, residual_layer, top_face_pressure, Primitives,
-    RhsInput,
+    axial_layer, gradients_layer, inlet_face_pressure, net_mass_inflow, primitives_layer, residual_layer,
+    top_face_pressure, Primitives, RhsInput,
 };
 use super::stability::cell_stable_dt;
 use super::team_step::{fits, team_step, StepInput, StepState};
@@ -71,6 +72,8 @@ pub struct GasSolver {
     /// Reported minus solver pressure: the case's outlet pressure less the solver's c²ρ_out
     /// (0 at the paper's sound speed; `anchor_pressure`).
     pressure_offset: f64,
+    /// The mass budget of the flux-updated cells (mass_budget.rs); checkpointed beside the state.
+    budget: MassBudget,
 }
 
 /// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
@@ -140,6 +143,7 @@ impl GasSolver {
             parallel: n >= PARALLEL_MIN_CELLS,
             team: true,
             pressure_offset: 0.0,
+            budget: MassBudget::default(),
             grid,
         }
     }
@@ -192,6 +196,7 @@ impl GasSolver {
             self.st.q[c].iter_mut().for_each(|v| *v *= f);
             self.st.eps[c] = e;
         }
+        self.budget = MassBudget::default();
     }
 
     /// Voidage per cell. The gas mass ρεV of each cell is held: ρ = (ρε)/ε_new, so displaced gas
@@ -214,6 +219,7 @@ impl GasSolver {
         let (ux, uy) = self.geo.to_cartesian(c, u_cyl[0], u_cyl[1]);
         let re = rho * self.st.eps[cell];
         self.st.q[cell] = [re, re * ux, re * uy, re * u_cyl[2]];
+        self.budget = MassBudget::default();
     }
 
     /// ρ (not ρε).
@@ -380,6 +386,7 @@ impl GasSolver {
     /// The face corrections F are integrated with the cell state by the same scheme. A multistep
     /// step runs as one team of threads (team_step.rs) when the pool is free for one.
     pub fn step(&mut self, dt: f64) {
+        self.start_mass_budget();
         if self.st.hist_len > 0 && self.parallel && self.team && fits(self.grid.nz, rayon::current_num_threads()) {
             if let Some(_team) = TeamLock::try_take() {
                 return self.team_step(dt);
@@ -392,9 +399,11 @@ impl GasSolver {
         let mut f_new = std::mem::take(&mut self.st.hist[newest]);
         let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
         self.rhs_into(t, &mut f_new, &mut g_new);
+        let net_new = self.net_inflow(t);
         let hl = self.st.hist_len;
         let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
+        let bh = self.budget.hist;
         {
             let (q, q0) = (self.st.q.as_flattened_mut(), self.q_old.as_flattened());
             let (ff, ff0) = (&mut self.st.face_flux, &self.face_old);
@@ -408,6 +417,7 @@ impl GasSolver {
                     let b = ab2_weights(dt, h1).map(|w| w * dt);
                     combine(q, q0, &[f_new.as_flattened(), self.st.hist[i1].as_flattened()], &b);
                     combine(ff, ff0, &[&g_new, &self.st.hist_face[i1]], &b);
+                    self.budget.net += b[0] * net_new + b[1] * bh[i1];
                 }
                 _ => {
                     let b = ab3_weights(dt, h1, h2).map(|w| w * dt);
@@ -418,6 +428,7 @@ impl GasSolver {
                         &b,
                     );
                     combine(ff, ff0, &[&g_new, &self.st.hist_face[i1], &self.st.hist_face[i2]], &b);
+                    self.budget.net += b[0] * net_new + b[1] * bh[i1] + b[2] * bh[i2];
                 }
             }
         }
@@ -433,9 +444,12 @@ impl GasSolver {
                 &[0.5 * dt, 0.5 * dt],
             );
             combine(&mut self.st.face_flux, &self.face_old, &[&g_new, &face_stage], &[0.5 * dt, 0.5 * dt]);
+            let net_stage = self.net_inflow(t + dt);
+            self.budget.net += 0.5 * dt * net_new + 0.5 * dt * net_stage;
             (self.stage, self.face_stage) = (stage, face_stage);
             self.apply_outlet(dt);
         }
+        self.budget.hist[newest] = net_new;
         self.st.hist[newest] = f_new;
         self.st.hist_face[newest] = g_new;
         self.st.head = newest;
@@ -484,6 +498,14 @@ impl GasSolver {
             axial: &mut self.axial,
         };
         team_step(&inp, s);
+        // The team's primitives and axial faces are those of this step's right-hand side.
+        let net_new = self.net_inflow(self.st.time);
+        let bh = self.budget.hist;
+        self.budget.net += match hl {
+            1 => ab2[0] * net_new + ab2[1] * bh[i1],
+            _ => ab3[0] * net_new + ab3[1] * bh[i1] + ab3[2] * bh[i2],
+        };
+        self.budget.hist[newest] = net_new;
         self.st.hist[newest] = f_new;
         self.st.hist_face[newest] = g_new;
         self.st.head = newest;
@@ -491,6 +513,62 @@ impl GasSolver {
         self.st.hist_len = (hl + 1).min(3);
         self.st.time += dt;
         self.st.steps += 1;
+    }
+
+    /// Cells updated by fluxes: all but the characteristic outlet layer (mass_budget.rs).
+    fn flux_updated_cells(&self) -> usize {
+        let (nz, per) = (self.grid.nz, self.grid.cells_per_layer());
+        if self.st.params.outlet == Outlet::Characteristic && nz > 1 {
+            (nz - 1) * per
+        } else {
+            nz * per
+        }
+    }
+
+    /// Gas mass of the flux-updated cells (kg; the cells have equal volumes).
+    fn held_mass(&self) -> f64 {
+        self.st.q[..self.flux_updated_cells()].iter().map(|s| s[0]).sum::<f64>() * self.grid.cell_volume()
+    }
+
+    /// ṁ_in − ṁ_out of the right-hand side just computed (its primitives and axial faces).
+    fn net_inflow(&self, t: f64) -> f64 {
+        let inp = RhsInput {
+            geo: &self.geo,
+            params: &self.st.params,
+            per: self.grid.cells_per_layer(),
+            nz: self.grid.nz,
+            dz: self.grid.dz,
+            eps: &self.st.eps,
+            force: &self.st.force,
+            face_flux: &self.st.face_flux,
+            time: t,
+        };
+        net_mass_inflow(&inp, &self.prim.p, &self.axial)
+    }
+
+    /// Start the budget at the current mass if it is not running; the history's net inflows are
+    /// the stored right-hand sides' mass rows summed (a checkpoint without the budget).
+    fn start_mass_budget(&mut self) {
+        if self.budget.start.is_some() {
+            return;
+        }
+        let (n, v) = (self.flux_updated_cells(), self.grid.cell_volume());
+        let hist = std::array::from_fn(|i| self.st.hist[i][..n].iter().map(|s| s[0]).sum::<f64>() * v);
+        self.budget = MassBudget { start: Some(self.held_mass()), net: 0.0, hist };
+    }
+
+    /// The gas mass budget now: mass held by the flux-updated cells, its change and the net inflow
+    /// since the budget started.
+    pub fn mass_balance(&self) -> MassBalance {
+        self.budget.balance(self.held_mass())
+    }
+    /// The budget, for checkpoints.
+    pub fn mass_budget(&self) -> MassBudget {
+        self.budget
+    }
+    /// Resume the budget of a checkpoint.
+    pub fn set_mass_budget(&mut self, b: MassBudget) {
+        self.budget = b;
     }
 
     /// The characteristic outlet layer after an update (`outlet_layer`).

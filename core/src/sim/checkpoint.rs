@@ -8,7 +8,8 @@
 //!
 //! Formats: 1–3 had no header (one bincode blob after the number); 4 is this layout; 5 adds the
 //! DEM pair pass's chunk cuts to the `dem` section. The `analysis` section (the run's analysis
-//! samples) is optional: a file without it resumes with an empty analysis window.
+//! samples) is optional: a file without it resumes with an empty analysis window; so is
+//! `gas_mass_budget` (cfd/mass_budget.rs): without it the budget starts at the resumed state.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -51,6 +52,7 @@ pub(super) fn encode(st: &State) -> Vec<u8> {
         part("dem", "bincode-1", bincode_of(&st.dem), &dem_shapes),
         part("gas", "bincode-1", bincode_of(&st.gas), &[]),
         part("analysis", "bincode-1", bincode_of(&st.analysis), &[]),
+        part("gas_mass_budget", "bincode-1", bincode_of(&st.gas.as_ref().map(|g| g.mass_budget())), &[]),
     ];
     let header =
         Header { format: FORMAT, writer: WRITER.into(), sections: parts.iter().map(|p| p.0.clone()).collect() };
@@ -120,7 +122,16 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
     let (steps, snapshots_taken) =
         bincode::deserialize(section("counters")?).map_err(|e| refuse("counters", e.to_string()))?;
     let dem = bincode::deserialize(section("dem")?).map_err(|e| refuse("dem", e.to_string()))?;
-    let gas = bincode::deserialize(section("gas")?).map_err(|e| refuse("gas", e.to_string()))?;
+    let mut gas: Option<crate::cfd::GasSolver> =
+        bincode::deserialize(section("gas")?).map_err(|e| refuse("gas", e.to_string()))?;
+    // A checkpoint from before the gas mass budget starts it afresh at the resumed state.
+    if let Some(body) = sections.get("gas_mass_budget") {
+        let budget: Option<crate::cfd::MassBudget> =
+            bincode::deserialize(body).map_err(|e| refuse("gas_mass_budget", e.to_string()))?;
+        if let (Some(g), Some(b)) = (gas.as_mut(), budget) {
+            g.set_mass_budget(b);
+        }
+    }
     // A checkpoint from before the run analysis starts its window afresh.
     let analysis = match sections.get("analysis") {
         Some(body) => bincode::deserialize(body).map_err(|e| refuse("analysis", e.to_string()))?,
@@ -166,16 +177,19 @@ mod tests {
         let (header, sections) = describe(&bytes).unwrap();
         assert_eq!((header.format, header.writer.as_str()), (FORMAT, WRITER));
         let names: Vec<&str> = header.sections.iter().map(|s| s.name.as_str()).collect();
-        assert_eq!(names, ["case", "plan", "counters", "dem", "gas", "analysis"]);
+        assert_eq!(names, ["case", "plan", "counters", "dem", "gas", "analysis", "gas_mass_budget"]);
         let dem = header.sections.iter().find(|s| s.name == "dem").unwrap();
         assert_eq!(dem.shapes["positions"], [4, 3]);
         assert_eq!(sections["dem"].len() as u64, dem.bytes);
         let back = Simulation::restore(&bytes).unwrap();
         assert_eq!(back.steps(), sim.steps());
         assert_eq!(back.dem().positions(), sim.dem().positions());
+        let budget = |s: &Simulation| s.gas().map(|g| g.mass_budget());
+        assert_eq!(budget(&back), budget(&sim));
         // A section that no longer matches is refused with its name, shapes and both versions.
         let mut bad = bytes.clone();
-        let cut = bad.len() - sections["analysis"].len() - sections["gas"].len() - 8;
+        let cut =
+            bad.len() - sections["gas_mass_budget"].len() - sections["analysis"].len() - sections["gas"].len() - 8;
         bad.truncate(cut);
         let err = Simulation::restore(&bad).err().unwrap().to_string();
         assert!(err.contains("section dem cut short"), "{err}");

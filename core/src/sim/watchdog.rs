@@ -27,6 +27,11 @@ pub const SPEED_FACTOR: f64 = 10.0;
 /// Gas density below this fraction of the outlet density: the pressure has collapsed.
 pub const COLLAPSED_DENSITY_FRACTION: f64 = 1e-2;
 
+/// Largest tolerated gas mass-budget error, (in − out − change) / mass held (cfd/mass_budget.rs):
+/// a conservative scheme closes it to round-off (≈ 1e-14 after a million DEM steps of the 44-mm
+/// bed); beyond this the fluxes no longer conserve mass.
+pub const MASS_BALANCE_TOLERANCE: f64 = 1e-9;
+
 /// How far (as a fraction of d) a centre may pass a wall before the particle has left the column:
 /// its overlap with the wall would be beyond anything the contact law can push back.
 const ESCAPE_FRACTION: f64 = 0.5;
@@ -70,8 +75,8 @@ fn at(x: [f64; 3]) -> String {
     format!("({:.4e}, {:.4e}, {:.4e}) m", x[0], x[1], x[2])
 }
 
-/// Every `GAS_CHECK_EVERY` gas steps: finite state, positive and not collapsed density, and the
-/// step within the acoustic/AB3 limit.
+/// Every `GAS_CHECK_EVERY` gas steps: finite state, positive and not collapsed density, the
+/// step within the acoustic/AB3 limit, and the gas mass budget closed.
 pub fn check_gas(gas: &GasSolver, lim: &Limits, dt: f64, t: f64, step: u64) -> Result<(), SimError> {
     gas.check_finite().map_err(|m| {
         SimError::Unstable(format!(
@@ -104,6 +109,17 @@ pub fn check_gas(gas: &GasSolver, lim: &Limits, dt: f64, t: f64, step: u64) -> R
     if dt > stable * (1.0 + 1e-9) {
         return Err(SimError::Unstable(format!(
             "gas step {dt:.3e} s exceeds the acoustic/AB3 limit {stable:.3e} s at {} (gas velocity grew); set gas.time_step_s below {stable:.3e} or lower gas.superficial_velocity_m_s",
+            when(t, step)
+        )));
+    }
+    let b = gas.mass_balance();
+    let err = b.relative_error();
+    if err.is_nan() || err.abs() > MASS_BALANCE_TOLERANCE {
+        return Err(SimError::Unstable(format!(
+            "gas mass balance off by {err:.3e} of the mass held (beyond {MASS_BALANCE_TOLERANCE:.0e}): in − out {:.6e} kg, change {:.6e} kg, held {:.6e} kg, at {}; the solver lost mass conservation, which no case setting causes: report it with the job's checkpoint",
+            b.net_inflow,
+            b.change,
+            b.held,
             when(t, step)
         )));
     }

@@ -114,3 +114,23 @@ fn collapsed_and_non_finite_gas_is_named_by_cell() {
     let m = stop_message(check_gas(&gas, &lim, 1e-7, 0.1, 7));
     assert!(m.contains("NaN") && m.contains("gas.time_step_s"), "{m}");
 }
+
+#[test]
+fn a_gas_mass_budget_that_does_not_close_stops_the_run() {
+    let mut c = case(vec![[0.0, 0.0, 0.05]], vec![[0.0; 3]]);
+    c.gas = Some(Default::default());
+    let grid = crate::sim::fluid_grid(&c);
+    let mut gas = GasSolver::new(&c, grid);
+    let lim = Limits::of(&c);
+    let dt = 0.5 * gas.stable_dt();
+    for _ in 0..50 {
+        gas.step(dt);
+    }
+    check_gas(&gas, &lim, dt, 50.0 * dt, 50).unwrap();
+    // A budget missing 1e-8 of the mass held (a flux that would not conserve mass) is stopped.
+    let mut b = gas.mass_budget();
+    b.net += 1e-8 * gas.mass_balance().held;
+    gas.set_mass_budget(b);
+    let m = stop_message(check_gas(&gas, &lim, dt, 50.0 * dt, 50));
+    assert!(m.contains("gas mass balance off by 1.000e-8") && m.contains("DEM step 50"), "{m}");
+}

@@ -4,6 +4,7 @@ mod acoustics;
 mod conservation;
 mod hydrostatic;
 mod layer_pressure;
+mod mass_budget;
 mod outlet_pressure;
 mod porous_zone;
 mod support;
