@@ -166,7 +166,7 @@ pub fn run() {
 
 /// The coupling's parts one by one on the fluidized state (`bench -- coupled-parts`): ms per call.
 pub fn parts() {
-    use fluidbed_core::coupling::{build_voidage, voidage_from_solid, Exchange, ExchangeParams, GasAtCells};
+    use fluidbed_core::coupling::{build_voidage, voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells};
     let case = shipped_case("bubbling-44mm.json");
     let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
     let (grid, dem, gas) = (sim.grid(), sim.dem(), sim.gas().expect("gas"));
@@ -201,7 +201,15 @@ pub fn parts() {
     let mut ex = Exchange::new(grid, dem.len());
     let (mut f, mut cf) = (vec![[0.0; 3]; dem.len()], vec![[0.0; 3]; n]);
     time("particle_gas_forces", &mut || {
-        ex.particle_gas_forces(grid, &at, par, (dem.positions(), dem.velocities()), &mut f, &mut cf)
+        ex.particle_gas_forces(
+            grid,
+            DragCells::cells(grid, at.voidage),
+            &at,
+            par,
+            (dem.positions(), dem.velocities()),
+            &mut f,
+            &mut cf,
+        )
     });
     let mut gas2 = gas.clone();
     let dt = sim.plan().gas_dt_s.expect("gas dt");

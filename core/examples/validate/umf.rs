@@ -9,7 +9,8 @@
 //! drag and U_mf comes out 20% high (docs/VALIDATION.md).
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
-//! the fluid layer height over the radial spacing).
+//! the fluid layer height over the radial spacing, and `sublayers`, the case's
+//! `coupling.drag_voidage_sublayers`).
 
 use crate::common::*;
 use serde_json::json;
@@ -25,6 +26,8 @@ struct Sweep {
     hold: f64,
     /// Fluid layer height over the radial spacing (1 = the paper's cells, dz = dr).
     dz_over_dr: f64,
+    /// `coupling.drag_voidage_sublayers` (None: the case's).
+    sublayers: Option<u32>,
 }
 
 impl Sweep {
@@ -38,6 +41,7 @@ impl Sweep {
             stages: 11,
             hold: 0.1,
             dz_over_dr: 0.5,
+            sublayers: None,
         };
         for kv in std::env::var("FLUIDBED_UMF").unwrap_or_default().split(',').filter(|t| !t.is_empty()) {
             let (k, v) = kv.split_once('=').unwrap_or_else(|| panic!("FLUIDBED_UMF: '{kv}' is not key=value"));
@@ -51,7 +55,8 @@ impl Sweep {
                 "stages" => s.stages = x as usize,
                 "hold" => s.hold = x,
                 "dz_over_dr" => s.dz_over_dr = x,
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr)"),
+                "sublayers" => s.sublayers = Some(x as u32),
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers)"),
             }
         }
         s
@@ -70,6 +75,9 @@ pub fn run() -> serde_json::Value {
             split: fluidbed_core::case::BoxSplit::Cuboid,
             cube_side_factor: 1.0,
         };
+    }
+    if let Some(n) = sw.sublayers {
+        case.coupling.drag_voidage_sublayers = n;
     }
     let dz = sw.dz_over_dr * case.grid.dr_m;
     case.grid.dz_m = Some(dz);
@@ -128,7 +136,12 @@ pub fn run() -> serde_json::Value {
         }
     }
     let umf = intersect(&points, want_weight);
-    crate::plots::umf_curve(&points, want_weight, umf, "docs/img/umf.png");
+    // A sweep other than the shipped one draws its curve under target/, not over the docs' figure.
+    let png = match std::env::var("FLUIDBED_UMF") {
+        Ok(v) if !v.is_empty() => format!("target/umf-{}.png", v.replace([',', '='], "_")),
+        _ => "docs/img/umf.png".to_string(),
+    };
+    crate::plots::umf_curve(&points, want_weight, umf, &png);
     let reference = 0.30;
     eprintln!("{n} particles, bed weight/area {want_weight:.1} Pa: U_mf = {umf:.3} m/s (reference {reference})");
     json!({"name": "umf", "figure": umf, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,

@@ -64,12 +64,28 @@ pub struct Coupling {
     /// stable step. Default from the run-time/error trade-off (docs/BENCHMARKS.md).
     #[serde(default = "d_coupling_interval")]
     pub interval_steps: u32,
+    /// Sub-layers of each fluid layer for the voidage the drag law reads (1 = the cell's voidage,
+    /// the paper's model). With n > 1 a particle's drag takes the voidage ε_s of the sub-layer of
+    /// height dz/n holding its centre and the interstitial velocity ε_c·u_c/ε_s of a gas flux
+    /// uniform over the cell; the gas equations keep the cell's voidage ε_c (coupling/exchange.rs).
+    /// It removes most of the dependence on where the cell faces fall at a bed surface or on the
+    /// plate (docs/VALIDATION.md, "U_mf with the paper's cells").
+    #[serde(default = "d_drag_sublayers")]
+    pub drag_voidage_sublayers: u32,
 }
 
 impl Default for Coupling {
     fn default() -> Self {
-        Coupling { drag_law: Default::default(), interval_steps: d_coupling_interval() }
+        Coupling {
+            drag_law: Default::default(),
+            interval_steps: d_coupling_interval(),
+            drag_voidage_sublayers: d_drag_sublayers(),
+        }
     }
+}
+
+fn d_drag_sublayers() -> u32 {
+    1
 }
 
 fn d_coupling_interval() -> u32 {

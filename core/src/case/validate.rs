@@ -236,6 +236,10 @@ impl Case {
         if !(1..=1000).contains(&n) {
             r.error("/coupling/interval_steps", n, "[1, 1000]", "DEM steps between couplings out of range");
         }
+        let m = self.coupling.drag_voidage_sublayers;
+        if !(1..=8).contains(&m) {
+            r.error("/coupling/drag_voidage_sublayers", m, "[1, 8]", "sub-layers of the drag voidage out of range");
+        }
         self.validate_run(&mut r);
         r.errors.extend(super::bounds::check(self));
         r

@@ -8,7 +8,15 @@
 //! in which the finite-volume solver holds that cell's momentum): this keeps Σ_particles F_d =
 //! −Σ_cells R(θ_c)·I·V_cell to round-off, whereas the particle's basis would rotate each
 //! contribution by up to half a cell width (±60° in the central annulus).
+//!
+//! Drag voidage on sub-layers (case `coupling.drag_voidage_sublayers` = n > 1; `DragCells`): the
+//! drag law reads the voidage ε_s of the sub-layer (height dz/n) holding the particle's centre and
+//! the interstitial velocity u_s = (ε_c/ε_s)·u_c, the cell's gas flux ε_c·u_c taken as uniform over
+//! the cell; the gas still loses the drag in its cell. For n = 1, ε_s = ε_c and u_s = u_c: the
+//! paper's model, the same bits.
 
+#[cfg(test)]
+use super::drag::beetstra_f;
 use super::drag::{clamp_voidage, drag_force, Beetstra, DiFelice, DragLaw, DragModel, Gidaspow};
 use crate::grid::CylGrid;
 use rayon::prelude::*;
@@ -45,6 +53,23 @@ fn angle_of(x: f64, y: f64) -> (f64, f64) {
         (x * inv, y * inv)
     } else {
         (1.0, 0.0)
+    }
+}
+
+/// Where the drag law reads its voidage: the fluid grid itself (`sublayers` 1, `voidage` the
+/// cells'), or a grid of `sublayers` layers per fluid layer and the same cells in each layer
+/// (`voidage` one value per sub-cell).
+#[derive(Clone, Copy)]
+pub struct DragCells<'a> {
+    pub grid: &'a CylGrid,
+    pub sublayers: usize,
+    pub voidage: &'a [f64],
+}
+
+impl<'a> DragCells<'a> {
+    /// The fluid cells themselves (the paper's model).
+    pub fn cells(grid: &'a CylGrid, voidage: &'a [f64]) -> DragCells<'a> {
+        DragCells { grid, sublayers: 1, voidage }
     }
 }
 
@@ -119,9 +144,11 @@ impl Exchange {
     /// interaction force per unit volume on the gas, I = −Σ drag / V_cell (cylindrical,
     /// cell-centre basis), into `cell_force_out` (overwritten). ε is clamped to [eps_min, 1).
     /// No allocation after the first call.
+    #[allow(clippy::too_many_arguments)]
     pub fn particle_gas_forces(
         &mut self,
         grid: &CylGrid,
+        drag: DragCells,
         gas: &GasAtCells,
         par: ExchangeParams,
         particles: (&[[f64; 3]], &[[f64; 3]]),
@@ -131,13 +158,13 @@ impl Exchange {
         let mut tables = std::mem::take(&mut self.tables);
         match par.law {
             DragModel::Beetstra => {
-                self.run(Beetstra, &mut tables.beetstra, grid, gas, par, particles, force_out, cell_force_out)
+                self.run(Beetstra, &mut tables.beetstra, grid, drag, gas, par, particles, force_out, cell_force_out)
             }
             DragModel::Gidaspow => {
-                self.run(Gidaspow, &mut tables.gidaspow, grid, gas, par, particles, force_out, cell_force_out)
+                self.run(Gidaspow, &mut tables.gidaspow, grid, drag, gas, par, particles, force_out, cell_force_out)
             }
             DragModel::DiFelice => {
-                self.run(DiFelice, &mut tables.di_felice, grid, gas, par, particles, force_out, cell_force_out)
+                self.run(DiFelice, &mut tables.di_felice, grid, drag, gas, par, particles, force_out, cell_force_out)
             }
         }
         self.tables = tables;
@@ -149,6 +176,7 @@ impl Exchange {
         law: L,
         table: &mut Vec<CellTable<L::Cell>>,
         grid: &CylGrid,
+        drag: DragCells,
         gas: &GasAtCells,
         par: ExchangeParams,
         (pos, vel): (&[[f64; 3]], &[[f64; 3]]),
@@ -157,21 +185,32 @@ impl Exchange {
     ) {
         assert_eq!(pos.len(), vel.len());
         assert_eq!(pos.len(), force_out.len());
-        let cells = grid.num_cells();
+        let (cells, per, m) = (grid.num_cells(), grid.cells_per_layer(), drag.sublayers.max(1));
         assert_eq!(cell_force_out.len(), cells);
+        // The drag's cells: m sub-cells per fluid cell, the same in-layer cells.
+        let drag_cells = drag.grid.num_cells();
+        assert!(drag.grid.cells_per_layer() == per && drag_cells == m * cells && drag.voidage.len() == drag_cells);
         self.cell_of.resize(pos.len(), 0);
-        // 1. per cell (parallel): everything that does not depend on the particle
-        let (mu, d, per) = (par.mu, par.d, grid.cells_per_layer());
-        table.resize(cells, CellTable::default());
+        // 1. per drag cell (parallel): everything that does not depend on the particle
+        let (mu, d) = (par.mu, par.d);
+        table.resize(drag_cells, CellTable::default());
         let basis = &self.cell_basis;
-        table.par_iter_mut().with_min_len(256).enumerate().for_each(|(c, t)| {
-            let eps = clamp_voidage(gas.voidage[c], par.eps_min);
+        table.par_iter_mut().with_min_len(256).enumerate().for_each(|(s, t)| {
+            let c = (s / per / m) * per + s % per;
+            let eps = clamp_voidage(drag.voidage[s], par.eps_min);
+            let u = gas.velocity_cyl[c];
+            let u_cyl = if m == 1 {
+                u
+            } else {
+                let f = clamp_voidage(gas.voidage[c], par.eps_min) / eps;
+                [f * u[0], f * u[1], f * u[2]]
+            };
             *t = CellTable {
-                u_cyl: gas.velocity_cyl[c],
+                u_cyl,
                 grad_cyl: gas.grad_p_cyl[c],
                 k: 3.0 * PI * mu * d * eps,
                 re_per_w: gas.density[c] * eps * d / mu,
-                basis: basis[c % per],
+                basis: basis[s % per],
                 law: law.cell(eps),
             };
         });
@@ -181,16 +220,22 @@ impl Exchange {
         let vp = PI * d * d * d / 6.0;
         let chunk = pos.len().div_ceil(CHUNKS).max(1);
         let table = &table[..];
-        self.chunk_force.resize_with(CHUNKS, || vec![[0.0; 3]; cells]);
+        let (dgrid, cells_d) = (drag.grid, drag_cells);
+        self.chunk_force.resize_with(CHUNKS, || vec![[0.0; 3]; cells_d]);
+        // Rows of chunks without particles add nothing.
+        for row in &mut self.chunk_force[pos.len().div_ceil(chunk)..] {
+            row.clear();
+            row.resize(cells_d, [0.0; 3]);
+        }
         (self.chunk_force.par_iter_mut(), force_out.par_chunks_mut(chunk), self.cell_of.par_chunks_mut(chunk))
             .into_par_iter()
             .enumerate()
             .for_each(|(n, (sum, f, co))| {
-                sum.resize(cells, [0.0; 3]);
+                sum.resize(cells_d, [0.0; 3]);
                 sum.fill([0.0; 3]);
                 let lo = n * chunk;
                 particle_block_pass_on::<L>(
-                    grid,
+                    dgrid,
                     table,
                     vp,
                     &pos[lo..lo + f.len()],
@@ -200,14 +245,18 @@ impl Exchange {
                     sum,
                 );
             });
-        // 3. the gas loses the drag: chunk sums in a fixed order, per unit volume
+        // 3. the gas loses the drag in its cell: chunk sums (and sub-cells) in a fixed order, per
+        //    unit volume
         let inv_v = 1.0 / grid.cell_volume();
         let sums = &self.chunk_force;
         cell_force_out.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
             let mut s = [0.0; 3];
-            for row in sums {
-                for m in 0..3 {
-                    s[m] += row[c][m];
+            let first = (c / per) * m * per + c % per;
+            for sub in 0..m {
+                for row in sums {
+                    for q in 0..3 {
+                        s[q] += row[first + sub * per][q];
+                    }
                 }
             }
             *out = [-s[0] * inv_v, -s[1] * inv_v, -s[2] * inv_v];
@@ -392,6 +441,10 @@ fn particle_block_pass<L: DragLaw>(
     }
 }
 #[cfg(test)]
+#[path = "exchange_sublayers_tests.rs"]
+mod sublayers_tests;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
@@ -432,7 +485,15 @@ mod tests {
         let mut cf = vec![[0.0; 3]; n];
         for law in [DragModel::Beetstra, DragModel::Gidaspow, DragModel::DiFelice] {
             let par = ExchangeParams { law, mu, eps_min: 0.1, d };
-            Exchange::new(&g, pos.len()).particle_gas_forces(&g, &gas, par, (&pos, &vel), &mut f, &mut cf);
+            Exchange::new(&g, pos.len()).particle_gas_forces(
+                &g,
+                DragCells::cells(&g, gas.voidage),
+                &gas,
+                par,
+                (&pos, &vel),
+                &mut f,
+                &mut cf,
+            );
             let vp = PI * d * d * d / 6.0;
             for k in 0..3 {
                 let w = [-vel[k][0], -vel[k][1], u - vel[k][2]];
@@ -475,7 +536,15 @@ mod tests {
         let (mut f, mut cf) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
         let d = 1.2e-3;
         let par = ExchangeParams { law: DragModel::Beetstra, mu: 1.8e-5, eps_min: 0.1, d };
-        Exchange::new(&g, pos.len()).particle_gas_forces(&g, &gas, par, (&pos, &vel), &mut f, &mut cf);
+        Exchange::new(&g, pos.len()).particle_gas_forces(
+            &g,
+            DragCells::cells(&g, gas.voidage),
+            &gas,
+            par,
+            (&pos, &vel),
+            &mut f,
+            &mut cf,
+        );
         // Σ drag on particles (total force minus −V_p∇p) against −Σ I·V_cell in Cartesian
         let vp = PI * d * d * d / 6.0;
         let mut drag = [0.0; 3];
@@ -569,7 +638,7 @@ mod tests {
         let (mut f, mut full, mut fast) = (vec![[0.0; 3]; pos.len()], vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
         let mut ex = Exchange::new(&g, pos.len());
         let par = ExchangeParams { law: DragModel::DiFelice, mu: 1.8e-5, eps_min: 0.1, d: 1.2e-3 };
-        ex.particle_gas_forces(&g, &gas, par, (&pos, &vel), &mut f, &mut full);
+        ex.particle_gas_forces(&g, DragCells::cells(&g, gas.voidage), &gas, par, (&pos, &vel), &mut f, &mut full);
         ex.freeze(&g, &pos);
         ex.frozen_cell_forces(&g, &gas, par, &mut fast);
         let scale = full.iter().flat_map(|v| v.iter()).fold(0.0f64, |m, x| m.max(x.abs()));

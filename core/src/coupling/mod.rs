@@ -6,5 +6,5 @@ pub mod fast_math;
 pub mod voidage;
 
 pub use drag::{beetstra_f, beta_a, drag_force, DragLaw, DragModel};
-pub use exchange::{Exchange, ExchangeParams, GasAtCells};
+pub use exchange::{DragCells, Exchange, ExchangeParams, GasAtCells};
 pub use voidage::{build_voidage, voidage_from_solid, VoidageMethod};

@@ -1,10 +1,13 @@
 //! The coupled step (paper section 2.3): voidage from the particles, drag and −V∇p on the
 //! particles, the opposite drag on the gas in the cell of each particle's centre, recomputed every
 //! `coupling.interval_steps` DEM steps and held in between; the gas steps at its own stable step
-//! and the particles at the DEM step, both by AB3.
+//! and the particles at the DEM step, both by AB3. With drag-voidage sub-layers
+//! (`coupling.drag_voidage_sublayers` = n > 1) the voidage method runs on the grid of n sub-layers
+//! per fluid layer; the cells' solid volume is the sum of their sub-cells' (exact: solid volume
+//! adds), and the drag reads the sub-cells' voidage (coupling/exchange.rs).
 
 use super::{watchdog, SimError, Simulation};
-use crate::coupling::{voidage_from_solid, Exchange, ExchangeParams, GasAtCells, VoidageMethod};
+use crate::coupling::{voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod};
 use crate::dem::DemSystem;
 use crate::grid::CylGrid;
 
@@ -19,10 +22,34 @@ pub(super) struct Buffers {
     pub exchange: Exchange,
     /// The voidage of a frozen bed is computed once.
     pub voidage_fresh: bool,
+    /// Drag-voidage sub-layers: their grid (n layers per fluid layer), solid volume and voidage.
+    pub sub: Option<SubLayers>,
+}
+
+pub(super) struct SubLayers {
+    pub n: usize,
+    pub grid: CylGrid,
+    pub solid: Vec<f64>,
+    pub voidage: Vec<f64>,
+}
+
+impl SubLayers {
+    pub fn new(grid: &CylGrid, n: usize) -> SubLayers {
+        let fine = sublayer_grid(grid, n);
+        let cells = fine.num_cells();
+        SubLayers { n, grid: fine, solid: vec![0.0; cells], voidage: vec![1.0; cells] }
+    }
+}
+
+/// The grid of `n` sub-layers per layer of `grid` (the same cells in each layer).
+pub(super) fn sublayer_grid(grid: &CylGrid, n: usize) -> CylGrid {
+    let fine = CylGrid::new(grid.radius, grid.height, grid.dr, grid.dz / n as f64, grid.n0);
+    assert_eq!(fine.nz, n * grid.nz, "sub-layers of the fluid layers");
+    fine
 }
 
 impl Buffers {
-    pub fn new(grid: &CylGrid, particles: usize) -> Buffers {
+    pub fn new(grid: &CylGrid, particles: usize, sublayers: usize) -> Buffers {
         let cells = grid.num_cells();
         Buffers {
             solid: vec![0.0; cells],
@@ -33,12 +60,26 @@ impl Buffers {
             cell_force: vec![[0.0; 3]; cells],
             exchange: Exchange::new(grid, particles),
             voidage_fresh: false,
+            sub: (sublayers > 1).then(|| SubLayers::new(grid, sublayers)),
         }
     }
 }
 
+/// The cells' voidage (and the sub-cells', with sub-layers) from the particles. With sub-layers
+/// `method` runs on their grid.
 pub(super) fn compute_voidage(grid: &CylGrid, method: &mut dyn VoidageMethod, dem: &DemSystem, buf: &mut Buffers) {
-    method.solid_volume(dem.positions(), dem.radius(), &mut buf.solid);
+    match buf.sub.as_mut() {
+        None => method.solid_volume(dem.positions(), dem.radius(), &mut buf.solid),
+        Some(sub) => {
+            method.solid_volume(dem.positions(), dem.radius(), &mut sub.solid);
+            voidage_from_solid(&sub.grid, &sub.solid, &mut sub.voidage);
+            let (per, n) = (grid.cells_per_layer(), sub.n);
+            for (c, s) in buf.solid.iter_mut().enumerate() {
+                let first = (c / per) * n * per + c % per;
+                *s = (0..n).map(|k| sub.solid[first + k * per]).sum();
+            }
+        }
+    }
     voidage_from_solid(grid, &buf.solid, &mut buf.voidage);
 }
 
@@ -59,7 +100,9 @@ impl Simulation {
         }
         let t0 = std::time::Instant::now();
         let gas = self.st.gas.as_mut().expect("coupling needs gas");
+        // The frozen shortcut reads the cells' voidage: with sub-layers the particle pass runs.
         let moving = self.st.plan.particles_move;
+        let per_particle = moving || self.buf.sub.is_some();
         if moving || !self.buf.voidage_fresh {
             compute_voidage(&self.grid, self.voidage.as_mut(), &self.st.dem, &mut self.buf);
             gas.set_voidage(&self.buf.voidage);
@@ -85,9 +128,13 @@ impl Simulation {
             eps_min: g.drag_voidage_min,
             d: 2.0 * dem.radius(),
         };
-        if moving {
+        if per_particle {
+            let drag = match &b.sub {
+                None => DragCells::cells(&self.grid, &b.voidage),
+                Some(s) => DragCells { grid: &s.grid, sublayers: s.n, voidage: &s.voidage },
+            };
             let (pos, vel, ext) = dem.coupling_views();
-            b.exchange.particle_gas_forces(&self.grid, &at, par, (pos, vel), ext, &mut b.cell_force);
+            b.exchange.particle_gas_forces(&self.grid, drag, &at, par, (pos, vel), ext, &mut b.cell_force);
         } else {
             b.exchange.frozen_cell_forces(&self.grid, &at, par, &mut b.cell_force);
         }

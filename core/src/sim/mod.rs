@@ -115,11 +115,17 @@ impl Simulation {
     }
 
     fn assemble(st: State, grid: CylGrid) -> Simulation {
-        let voidage = build_voidage(&st.case, &grid);
+        let sublayers = st.case.coupling.drag_voidage_sublayers.max(1) as usize;
+        // With drag-voidage sub-layers the method runs on their grid (coupled.rs).
+        let voidage = if sublayers > 1 && st.case.gas.is_some() {
+            build_voidage(&st.case, &coupled::sublayer_grid(&grid, sublayers))
+        } else {
+            build_voidage(&st.case, &grid)
+        };
         let dt = st.case.dem.time_step_s;
         let steps_per_snapshot = ((st.case.outputs.snapshot_interval_s / dt).round() as u64).max(1);
         let end_steps = ((st.case.end_time_s / dt).round() as u64).max(1);
-        let buf = coupled::Buffers::new(&grid, st.dem.len());
+        let buf = coupled::Buffers::new(&grid, st.dem.len(), if st.case.gas.is_some() { sublayers } else { 1 });
         let limits = watchdog::Limits::of(&st.case);
         Simulation { st, timers: StageTimers::default(), grid, voidage, buf, steps_per_snapshot, end_steps, limits }
     }
