@@ -25,13 +25,14 @@ fn main() {
         "fluidized" => report(fluidized::run()),
         "fig3" => report(fig3::run()),
         "umf" => report(umf::run()),
+        "umf-paper-cells" => report(umf::run_paper_cells()),
         "bubbling" => report(bubbling::run()),
         "bubbling-stats" => report(bubbling_stats::run()),
         "analysis-signals" => report(analysis_signals::run()),
         // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
         "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),
         other => {
-            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, fig3, bubbling or analysis-signals");
+            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, umf-paper-cells, fig3, bubbling or analysis-signals");
             std::process::exit(2);
         }
     }

@@ -10,7 +10,11 @@ pub fn run(small: bool) -> serde_json::Value {
     let mut worst_ergun = 0.0f64;
     let mut rows = Vec::new();
     for u in [0.15, 0.20, 0.25] {
-        let mut case = load_case("packed-bed.json");
+        // `FLUIDBED_PACKED_BED_CASE=FILE` runs another case file (its U is set here).
+        let mut case = match std::env::var("FLUIDBED_PACKED_BED_CASE") {
+            Ok(path) => load_case_path(&path),
+            Err(_) => load_case("packed-bed.json"),
+        };
         if small {
             // A narrower, shallower bed for `cargo test`: same physics, fewer particles.
             case.column.diameter_m = 0.0264;

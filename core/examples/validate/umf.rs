@@ -10,7 +10,8 @@
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
-//! `coupling.drag_voidage_sublayers`).
+//! `coupling.drag_voidage_sublayers`). `umf-paper-cells` runs the same sweep with dz = dr and the
+//! drag voidage on 8 sub-layers per cell.
 
 use crate::common::*;
 use serde_json::json;
@@ -31,8 +32,9 @@ struct Sweep {
 }
 
 impl Sweep {
-    fn from_env() -> Sweep {
-        let mut s = Sweep {
+    /// The shipped sweep: layers half as tall as the cells are wide.
+    fn shipped() -> Sweep {
+        Sweep {
             column_mm: 22.0,
             height_mm: 20.0,
             seed: 2,
@@ -42,7 +44,12 @@ impl Sweep {
             hold: 0.1,
             dz_over_dr: 0.5,
             sublayers: None,
-        };
+        }
+    }
+
+    /// `base` with the keys of `FLUIDBED_UMF` over it.
+    fn from_env(base: Sweep) -> Sweep {
+        let mut s = base;
         for kv in std::env::var("FLUIDBED_UMF").unwrap_or_default().split(',').filter(|t| !t.is_empty()) {
             let (k, v) = kv.split_once('=').unwrap_or_else(|| panic!("FLUIDBED_UMF: '{kv}' is not key=value"));
             let x: f64 = v.parse().unwrap_or_else(|_| panic!("FLUIDBED_UMF: '{v}' is not a number"));
@@ -64,7 +71,17 @@ impl Sweep {
 }
 
 pub fn run() -> serde_json::Value {
-    let sw = Sweep::from_env();
+    sweep(Sweep::from_env(Sweep::shipped()), "umf", "docs/img/umf.png")
+}
+
+/// The same sweep on the paper's cells (dz = dr) with the drag voidage on 8 sub-layers per cell
+/// (`coupling.drag_voidage_sublayers`, docs/VALIDATION.md "U_mf with the paper's cells").
+pub fn run_paper_cells() -> serde_json::Value {
+    let base = Sweep { dz_over_dr: 1.0, sublayers: Some(8), ..Sweep::shipped() };
+    sweep(Sweep::from_env(base), "umf-paper-cells", "docs/img/umf_paper_cells.png")
+}
+
+fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     let mut case = load_case("bubbling-44mm.json");
     if sw.column_mm != 44.0 {
         // a narrower column: keep three rings per radius
@@ -139,12 +156,12 @@ pub fn run() -> serde_json::Value {
     // A sweep other than the shipped one draws its curve under target/, not over the docs' figure.
     let png = match std::env::var("FLUIDBED_UMF") {
         Ok(v) if !v.is_empty() => format!("target/umf-{}.png", v.replace([',', '='], "_")),
-        _ => "docs/img/umf.png".to_string(),
+        _ => docs_png.to_string(),
     };
     crate::plots::umf_curve(&points, want_weight, umf, &png);
     let reference = 0.30;
     eprintln!("{n} particles, bed weight/area {want_weight:.1} Pa: U_mf = {umf:.3} m/s (reference {reference})");
-    json!({"name": "umf", "figure": umf, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
+    json!({"name": name, "figure": umf, "dz_over_dr": sw.dz_over_dr, "drag_voidage_sublayers": sw.sublayers.unwrap_or(1), "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
            "points": points.iter().map(|(u, p)| json!({"u_m_s": u, "dp_pa": p})).collect::<Vec<_>>()})
 }
 

@@ -66,10 +66,11 @@ pub struct Coupling {
     pub interval_steps: u32,
     /// Sub-layers of each fluid layer for the voidage the drag law reads (1 = the cell's voidage,
     /// the paper's model). With n > 1 a particle's drag takes the voidage ε_s of the sub-layer of
-    /// height dz/n holding its centre and the interstitial velocity ε_c·u_c/ε_s of a gas flux
-    /// uniform over the cell; the gas equations keep the cell's voidage ε_c (coupling/exchange.rs).
-    /// It removes most of the dependence on where the cell faces fall at a bed surface or on the
-    /// plate (docs/VALIDATION.md, "U_mf with the paper's cells").
+    /// height dz/n holding its centre (averaged with the sub-layers above and below) and the
+    /// interstitial velocity ε_c·u_c/ε_s of a gas flux uniform over the cell, and its share of the
+    /// sub-layer's pressure drop; the gas equations keep the cell's voidage ε_c
+    /// (coupling/exchange.rs). At the bed surface and the plate it stands in for layers thinner
+    /// than the cells (docs/VALIDATION.md, "U_mf with the paper's cells and the drag voidage on sub-layers").
     #[serde(default = "d_drag_sublayers")]
     pub drag_voidage_sublayers: u32,
 }

@@ -12,12 +12,14 @@
 //! Drag voidage on sub-layers (case `coupling.drag_voidage_sublayers` = n > 1; `DragCells`): the
 //! drag law reads the voidage ε_s of the sub-layer (height dz/n) holding the particle's centre and
 //! the interstitial velocity u_s = (ε_c/ε_s)·u_c, the cell's gas flux ε_c·u_c taken as uniform over
-//! the cell; the gas still loses the drag in its cell. For n = 1, ε_s = ε_c and u_s = u_c: the
-//! paper's model, the same bits.
+//! the cell; the gas still loses the drag in its cell, and each particle gets its sub-cell's share
+//! of the pressure drop (sublayer_pressure.rs). For n = 1, ε_s = ε_c and u_s = u_c: the paper's
+//! model, the same bits.
 
 #[cfg(test)]
 use super::drag::beetstra_f;
 use super::drag::{clamp_voidage, drag_force, Beetstra, DiFelice, DragLaw, DragModel, Gidaspow};
+use super::sublayer_pressure::{add_sublayer_pressure, SubLayerDrag};
 use crate::grid::CylGrid;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -113,6 +115,9 @@ pub struct Exchange {
     tables: Tables,
     /// Drag on the gas per chunk and cell (cell basis), summed into the caller's output.
     chunk_force: Vec<Vec<[f64; 3]>>,
+    /// Sub-layers: the pressure correction the gas loses per sub-cell, and scratch (sublayer_pressure.rs).
+    sub_lost: Vec<[f64; 3]>,
+    sub_scratch: Vec<[f64; 3]>,
 }
 
 #[derive(Default)]
@@ -137,6 +142,8 @@ impl Exchange {
             frozen: Vec::new(),
             tables: Tables::default(),
             chunk_force: vec![vec![[0.0; 3]; grid.num_cells()]; CHUNKS],
+            sub_lost: Vec::new(),
+            sub_scratch: Vec::new(),
         }
     }
 
@@ -245,10 +252,26 @@ impl Exchange {
                     sum,
                 );
             });
-        // 3. the gas loses the drag in its cell: chunk sums (and sub-cells) in a fixed order, per
-        //    unit volume
+        // 3. with sub-layers, each particle's share of its sub-cell's pressure drop
+        if m > 1 {
+            let d = SubLayerDrag {
+                sums: &self.chunk_force,
+                voidage: drag.voidage,
+                eps_min: par.eps_min,
+                cell_of: &self.cell_of,
+                per,
+                n: m,
+                v_sub: drag.grid.cell_volume(),
+                vp,
+                basis,
+            };
+            add_sublayer_pressure(&d, force_out, &mut self.sub_lost, &mut self.sub_scratch);
+        }
+        // 4. the gas loses the drag (and the sub-layers' pressure correction) in its cell: chunk
+        //    sums and sub-cells in a fixed order, per unit volume
         let inv_v = 1.0 / grid.cell_volume();
         let sums = &self.chunk_force;
+        let lost = &self.sub_lost;
         cell_force_out.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
             let mut s = [0.0; 3];
             let first = (c / per) * m * per + c % per;
@@ -256,6 +279,11 @@ impl Exchange {
                 for row in sums {
                     for q in 0..3 {
                         s[q] += row[first + sub * per][q];
+                    }
+                }
+                if m > 1 {
+                    for q in 0..3 {
+                        s[q] += lost[first + sub * per][q];
                     }
                 }
             }

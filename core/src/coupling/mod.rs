@@ -3,6 +3,7 @@
 pub mod drag;
 pub mod exchange;
 pub mod fast_math;
+mod sublayer_pressure;
 pub mod voidage;
 
 pub use drag::{beetstra_f, beta_a, drag_force, DragLaw, DragModel};

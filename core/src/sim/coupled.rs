@@ -4,7 +4,8 @@
 //! and the particles at the DEM step, both by AB3. With drag-voidage sub-layers
 //! (`coupling.drag_voidage_sublayers` = n > 1) the voidage method runs on the grid of n sub-layers
 //! per fluid layer; the cells' solid volume is the sum of their sub-cells' (exact: solid volume
-//! adds), and the drag reads the sub-cells' voidage (coupling/exchange.rs).
+//! adds), and the drag reads the sub-cells' voidage averaged over a window of three sub-layers
+//! (coupling/exchange.rs, `windowed_voidage`).
 
 use super::{watchdog, SimError, Simulation};
 use crate::coupling::{voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod};
@@ -48,6 +49,20 @@ pub(super) fn sublayer_grid(grid: &CylGrid, n: usize) -> CylGrid {
     fine
 }
 
+/// The drag voidage of each sub-cell: the solid volume of it and of the sub-cells above and below
+/// it in its column (a window of three sub-layers; two at the plate and the top) over their volume.
+/// The window smooths the layering of particles in sub-layers thinner than a particle, which the
+/// drag law (convex in ε) would turn into extra drag (docs/VALIDATION.md).
+fn windowed_voidage(fine: &CylGrid, solid: &[f64], out: &mut [f64]) {
+    let (per, nz, v) = (fine.cells_per_layer(), fine.nz, fine.cell_volume());
+    for (s, e) in out.iter_mut().enumerate() {
+        let k = s / per;
+        let (lo, hi) = (k.saturating_sub(1), (k + 1).min(nz - 1));
+        let sum: f64 = (lo..=hi).map(|k2| solid[s - k * per + k2 * per]).sum();
+        *e = 1.0 - sum / ((hi - lo + 1) as f64 * v);
+    }
+}
+
 impl Buffers {
     pub fn new(grid: &CylGrid, particles: usize, sublayers: usize) -> Buffers {
         let cells = grid.num_cells();
@@ -72,7 +87,7 @@ pub(super) fn compute_voidage(grid: &CylGrid, method: &mut dyn VoidageMethod, de
         None => method.solid_volume(dem.positions(), dem.radius(), &mut buf.solid),
         Some(sub) => {
             method.solid_volume(dem.positions(), dem.radius(), &mut sub.solid);
-            voidage_from_solid(&sub.grid, &sub.solid, &mut sub.voidage);
+            windowed_voidage(&sub.grid, &sub.solid, &mut sub.voidage);
             let (per, n) = (grid.cells_per_layer(), sub.n);
             for (c, s) in buf.solid.iter_mut().enumerate() {
                 let first = (c / per) * n * per + c % per;
@@ -180,5 +195,30 @@ impl Simulation {
             watchdog::check_dem(&self.st.dem, &self.limits, self.st.steps, self.time())?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_drag_voidage_window_averages_three_sublayers_of_a_column() {
+        let fine = sublayer_grid(&CylGrid::new(0.01, 0.008, 0.005, 0.004, 3), 4);
+        let (per, v) = (fine.cells_per_layer(), fine.cell_volume());
+        // Solid 0.6 V in sub-cell (layer 3, cell 2) only: it and its two neighbours read 0.2 V.
+        let mut solid = vec![0.0; fine.num_cells()];
+        solid[3 * per + 2] = 0.6 * v;
+        let mut eps = vec![0.0; fine.num_cells()];
+        windowed_voidage(&fine, &solid, &mut eps);
+        for (s, e) in eps.iter().enumerate() {
+            let want = if s % per == 2 && (2..=4).contains(&(s / per)) { 0.8 } else { 1.0 };
+            assert!((e - want).abs() < 1e-15, "sub-cell {s}: {e} vs {want}");
+        }
+        // At the plate the window is the bottom two sub-layers.
+        solid.fill(0.0);
+        solid[per] = 0.5 * v;
+        windowed_voidage(&fine, &solid, &mut eps);
+        assert!((eps[0] - 0.75).abs() < 1e-15 && (eps[per] - 1.0 + 0.5 / 3.0).abs() < 1e-15, "{} {}", eps[0], eps[per]);
     }
 }
