@@ -62,6 +62,7 @@ mod geometry;
 mod mass_budget;
 mod params;
 mod rhs;
+mod rhs_layers;
 mod smart;
 mod solver;
 mod stability;

@@ -6,10 +6,8 @@ use super::boundary::{outlet_layer, OutletGeometry};
 use super::geometry::FaceGeometry;
 use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet};
-use super::rhs::{
-    axial_layer, gradients_layer, inlet_face_pressure, net_mass_inflow, primitives_layer, residual_layer,
-    top_face_pressure, Primitives, RhsInput,
-};
+use super::rhs::{inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives, RhsInput};
+use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
 use super::stability::cell_stable_dt;
 use super::team_step::{fits, team_step, StepInput, StepState};
 use crate::case::Case;

@@ -11,7 +11,8 @@ use super::ab3::combine;
 use super::boundary::{outlet_layer, OutletGeometry};
 use super::geometry::FaceGeometry;
 use super::params::{GasParams, Outlet};
-use super::rhs::{axial_layer, gradients_layer, primitives_layer, residual_layer, PrimView, Primitives, RhsInput};
+use super::rhs::{PrimView, Primitives, RhsInput};
+use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
 use crate::team::{Raw, SpinBarrier};
 
 /// Everything one step reads besides the state.
