@@ -87,11 +87,7 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
         // a narrower column: keep three rings per radius
         case.column.diameter_m = sw.column_mm / 1000.0;
         case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
-        case.voidage = fluidbed_core::case::Voidage::SquareGrid {
-            box_side_m: None,
-            split: fluidbed_core::case::BoxSplit::Cuboid,
-            cube_side_factor: 1.0,
-        };
+        // (the shipped case's voidage: its boxes and cube are set by d, not by the column)
     }
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;

@@ -78,12 +78,19 @@ fn two_stage_cuboid(
     }
     let vp = 4.0 / 3.0 * PI * radius.powi(3);
     let chunk = positions.len().div_ceil(BOX_CHUNKS).max(1);
+    // Only the layers that a cube reaches are cleared, filled and reduced (a bed's freeboard holds
+    // no solid): the cubes span [z − h/2, z + h/2], so layers cell(z_min − h/2) ..= cell(z_max + h/2).
+    let up = Axis::new(0.0, g.dz, g.nz);
+    let (z_min, z_max) =
+        positions.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
+    let (k0, k1) = if positions.is_empty() { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
+    let rows = k0 * nb * nb..k1 * nb * nb;
     bufs.par_iter_mut().enumerate().for_each(|(n, buf)| {
-        buf.fill(0.0);
+        buf[rows.clone()].fill(0.0);
         let lo = (n * chunk).min(positions.len());
         let hi = ((n + 1) * chunk).min(positions.len());
         let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
-        let (across, up) = (Axis::new(bg.origin, bg.dl, nb), Axis::new(0.0, g.dz, g.nz));
+        let across = Axis::new(bg.origin, bg.dl, nb);
         if h <= bg.dl && h <= g.dz {
             // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
             for p in &positions[lo..hi] {
@@ -118,6 +125,9 @@ fn two_stage_cuboid(
     let (first, rest) = bufs.split_at(1);
     out.par_chunks_mut(per).enumerate().for_each(|(k, layer)| {
         layer.fill(0.0);
+        if !(k0..k1).contains(&k) {
+            return;
+        }
         for by in 0..nb {
             for bx in 0..nb {
                 let b = (k * nb + by) * nb + bx;
@@ -231,5 +241,38 @@ mod two_stage_tests {
         }
         let total: f64 = fast.iter().sum();
         assert!((total / (vp * pos.len() as f64) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn layers_without_solid_are_skipped_and_keep_nothing_from_an_earlier_call() {
+        // A bed in the top layers, then the same bed dropped to the bottom: the second call must
+        // equal a fresh method's (no stale box sums in the layers the first call filled), and the
+        // layers no cube reaches hold exactly nothing. Both box sizes: the 8-add path (cube ≤ box)
+        // and the general one.
+        let g = CylGrid::new(0.022, 0.0264, 0.0044, 0.0022, 3);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let (radius, per) = (0.0006, g.cells_per_layer());
+        let high: Vec<[f64; 3]> = (0..3000)
+            .map(|_| {
+                let (r, t) = (0.0214 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                [r * t.cos(), r * t.sin(), rng.gen_range(0.018..0.0258)]
+            })
+            .collect();
+        let low: Vec<[f64; 3]> = high.iter().map(|p| [p[0], p[1], p[2] - 0.0175]).collect();
+        for (side, f) in [(0.0008, 0.66), (0.001375, 1.0)] {
+            let mut reused = SquareGrid::new(&g, side, BoxSplit::Cuboid, f);
+            let mut out = vec![0.0; g.num_cells()];
+            reused.solid_volume(&high, radius, &mut out);
+            reused.solid_volume(&low, radius, &mut out);
+            let mut fresh = vec![0.0; g.num_cells()];
+            SquareGrid::new(&g, side, BoxSplit::Cuboid, f).solid_volume(&low, radius, &mut fresh);
+            assert!(out == fresh, "box {side}: a reused method differs from a fresh one");
+            let top = low.iter().map(|p| p[2]).fold(0.0, f64::max) + f * radius;
+            let first_empty = (top / g.dz).floor() as usize + 1;
+            assert!(out[first_empty * per..].iter().all(|&v| v == 0.0), "box {side}: solid above the bed");
+            let vp = 4.0 / 3.0 * PI * radius.powi(3);
+            let total: f64 = out.iter().sum();
+            assert!((total / (vp * low.len() as f64) - 1.0).abs() < 1e-12, "box {side}: volume {total}");
+        }
     }
 }
