@@ -78,60 +78,75 @@ fn two_stage_cuboid(
     }
     let vp = 4.0 / 3.0 * PI * radius.powi(3);
     let chunk = positions.len().div_ceil(BOX_CHUNKS).max(1);
-    // Only the layers that a cube reaches are cleared, filled and reduced (a bed's freeboard holds
-    // no solid): the cubes span [z − h/2, z + h/2], so layers cell(z_min − h/2) ..= cell(z_max + h/2).
+    // Each chunk clears, fills and hands on only the layers its cubes reach (the particles are
+    // in the DEM's z-major cell order, so the chunks are mostly the lower and the upper bed, and
+    // the freeboard holds no solid): cubes span [z − h/2, z + h/2], so layers
+    // cell(z_min − h/2) ..= cell(z_max + h/2) of the chunk.
     let up = Axis::new(0.0, g.dz, g.nz);
-    let (z_min, z_max) =
-        positions.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
-    let (k0, k1) = if positions.is_empty() { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
-    let rows = k0 * nb * nb..k1 * nb * nb;
-    bufs.par_iter_mut().enumerate().for_each(|(n, buf)| {
-        buf[rows.clone()].fill(0.0);
-        let lo = (n * chunk).min(positions.len());
-        let hi = ((n + 1) * chunk).min(positions.len());
-        let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
-        let across = Axis::new(bg.origin, bg.dl, nb);
-        if h <= bg.dl && h <= g.dz {
-            // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
+    let ranges: Vec<(usize, usize)> = bufs
+        .par_iter_mut()
+        .enumerate()
+        .map(|(n, buf)| {
+            let lo = (n * chunk).min(positions.len());
+            let hi = ((n + 1) * chunk).min(positions.len());
+            let (z_min, z_max) = positions[lo..hi]
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
+            let (k0, k1) = if lo == hi { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
+            buf[k0 * nb * nb..k1 * nb * nb].fill(0.0);
+            let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
+            let across = Axis::new(bg.origin, bg.dl, nb);
+            if h <= bg.dl && h <= g.dz {
+                // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
+                for p in &positions[lo..hi] {
+                    let (sx, sy, sz) =
+                        (split_two(p[0], h, &across), split_two(p[1], h, &across), split_two(p[2], h, &up));
+                    for &(k, wz) in &sz {
+                        for &(by, wy) in &sy {
+                            let row = (k * nb + by) * nb;
+                            for &(bx, wx) in &sx {
+                                buf[row + bx] += vp * wx * wy * wz;
+                            }
+                        }
+                    }
+                }
+                return (k0, k1);
+            }
             for p in &positions[lo..hi] {
-                let (sx, sy, sz) = (split_two(p[0], h, &across), split_two(p[1], h, &across), split_two(p[2], h, &up));
-                for &(k, wz) in &sz {
-                    for &(by, wy) in &sy {
+                let nx = interval_split(p[0], h, &across, &mut fx);
+                let ny = interval_split(p[1], h, &across, &mut fy);
+                let nz = interval_split(p[2], h, &up, &mut fz);
+                for &(k, sz) in &fz[..nz] {
+                    for &(by, sy) in &fy[..ny] {
                         let row = (k * nb + by) * nb;
-                        for &(bx, wx) in &sx {
-                            buf[row + bx] += vp * wx * wy * wz;
+                        for &(bx, sx) in &fx[..nx] {
+                            buf[row + bx] += vp * sx * sy * sz;
                         }
                     }
                 }
             }
-            return;
-        }
-        for p in &positions[lo..hi] {
-            let nx = interval_split(p[0], h, &across, &mut fx);
-            let ny = interval_split(p[1], h, &across, &mut fy);
-            let nz = interval_split(p[2], h, &up, &mut fz);
-            for &(k, sz) in &fz[..nz] {
-                for &(by, sy) in &fy[..ny] {
-                    let row = (k * nb + by) * nb;
-                    for &(bx, sx) in &fx[..nx] {
-                        buf[row + bx] += vp * sx * sy * sz;
-                    }
-                }
-            }
-        }
-    });
-    // boxes → cells, layer by layer (parallel over layers; each layer writes its own cells)
+            (k0, k1)
+        })
+        .collect();
+    // boxes → cells, layer by layer (parallel over layers; each layer writes its own cells), from
+    // the chunks whose layers include it, in chunk order
     let per = g.cells_per_layer();
-    let (first, rest) = bufs.split_at(1);
     out.par_chunks_mut(per).enumerate().for_each(|(k, layer)| {
         layer.fill(0.0);
-        if !(k0..k1).contains(&k) {
+        let (mut from, mut m): ([&[f64]; BOX_CHUNKS], usize) = ([&[]; BOX_CHUNKS], 0);
+        for (b, r) in bufs.iter().zip(&ranges) {
+            if (r.0..r.1).contains(&k) {
+                (from[m], m) = (b, m + 1);
+            }
+        }
+        if m == 0 {
             return;
         }
+        let (first, rest) = (from[0], &from[1..m]);
         for by in 0..nb {
             for bx in 0..nb {
                 let b = (k * nb + by) * nb + bx;
-                let v: f64 = first[0][b] + rest.iter().map(|r| r[b]).sum::<f64>();
+                let v: f64 = first[b] + rest.iter().map(|r| r[b]).sum::<f64>();
                 if v != 0.0 {
                     for &(c, f) in bg.cells_of(bx, by) {
                         layer[c as usize] += v * f;
