@@ -540,27 +540,51 @@ mod tests {
         }
     }
 
+    /// A random gas state at the n cells of the test grid (∇p with a random θ component when
+    /// `swirl`) and m random particles in its column, for the conservation tests.
+    pub(super) struct RandomScene {
+        pub vel_c: Vec<[f64; 3]>,
+        pub dens: Vec<f64>,
+        pub grad: Vec<[f64; 3]>,
+        pub void: Vec<f64>,
+        pub pos: Vec<[f64; 3]>,
+        pub vel: Vec<[f64; 3]>,
+    }
+
+    impl RandomScene {
+        pub(super) fn new(rng: &mut rand_chacha::ChaCha8Rng, n: usize, m: usize, swirl: bool) -> RandomScene {
+            let vel_c =
+                (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
+            let dens = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
+            let grad = (0..n)
+                .map(|_| [rng.gen_range(-50.0..50.0), if swirl { rng.gen_range(-50.0..50.0) } else { 0.0 }, -6000.0])
+                .collect();
+            let void = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
+            let pos = (0..m)
+                .map(|_| {
+                    let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                    [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
+                })
+                .collect();
+            let vel = (0..m)
+                .map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)])
+                .collect();
+            RandomScene { vel_c, dens, grad, void, pos, vel }
+        }
+
+        pub(super) fn gas(&self) -> GasAtCells<'_> {
+            GasAtCells { velocity_cyl: &self.vel_c, density: &self.dens, grad_p_cyl: &self.grad, voidage: &self.void }
+        }
+    }
+
     #[test]
     fn momentum_is_conserved_between_the_phases() {
         let g = grid();
         let n = g.num_cells();
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
-        let vel_c: Vec<[f64; 3]> =
-            (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
-        let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
-        let grad: Vec<[f64; 3]> =
-            (0..n).map(|_| [rng.gen_range(-50.0..50.0), rng.gen_range(-50.0..50.0), -6000.0]).collect();
-        let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
-        let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
         let m = 5000;
-        let pos: Vec<[f64; 3]> = (0..m)
-            .map(|_| {
-                let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
-                [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
-            })
-            .collect();
-        let vel: Vec<[f64; 3]> =
-            (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
+        let scene = RandomScene::new(&mut rng, n, m, true);
+        let (gas, pos, vel, grad) = (scene.gas(), &scene.pos, &scene.vel, &scene.grad);
         let (mut f, mut cf) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
         let d = 1.2e-3;
         let par = ExchangeParams { law: DragModel::Beetstra, mu: 1.8e-5, eps_min: 0.1, d };
@@ -569,7 +593,7 @@ mod tests {
             DragCells::cells(&g, gas.voidage),
             &gas,
             par,
-            (&pos, &vel),
+            (pos, vel),
             &mut f,
             &mut cf,
         );

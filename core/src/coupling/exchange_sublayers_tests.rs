@@ -66,27 +66,15 @@ fn what_the_particles_gain_with_sublayers_the_gas_loses() {
     let (g, fine) = grids();
     let n = g.num_cells();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(31);
-    let vel_c: Vec<[f64; 3]> =
-        (0..n).map(|_| [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(0.0..2.0)]).collect();
-    let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
-    let grad: Vec<[f64; 3]> = (0..n).map(|_| [rng.gen_range(-50.0..50.0), 0.0, -6000.0]).collect();
-    let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
-    let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
     let m = 4000;
-    let pos: Vec<[f64; 3]> = (0..m)
-        .map(|_| {
-            let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
-            [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0132)]
-        })
-        .collect();
-    let vel: Vec<[f64; 3]> =
-        (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
+    let scene = super::tests::RandomScene::new(&mut rng, n, m, false);
+    let (gas, pos, vel, grad) = (scene.gas(), &scene.pos, &scene.vel, &scene.grad);
     let par = ExchangeParams { law: DragModel::Beetstra, mu: 1.8e-5, eps_min: 0.1, d: 1.2e-3 };
     let (mut f2, mut c2) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
     // Random sub-layer voidage: what the particles gain (less −V_p∇p) the gas loses.
     let sub: Vec<f64> = (0..fine.num_cells()).map(|_| rng.gen_range(0.35..1.0)).collect();
     let drag = DragCells { grid: &fine, sublayers: 2, voidage: &sub };
-    Exchange::new(&g, m).particle_gas_forces(&g, drag, &gas, par, (&pos, &vel), &mut f2, &mut c2);
+    Exchange::new(&g, m).particle_gas_forces(&g, drag, &gas, par, (pos, vel), &mut f2, &mut c2);
     let vp = PI * par.d.powi(3) / 6.0;
     let scale = f2.iter().flatten().fold(0.0f64, |a, x| a.max(x.abs()));
     let (mut on_particles, mut on_gas) = ([0.0; 3], [0.0; 3]);
