@@ -135,28 +135,22 @@ fn every_code_path_gives_the_same_bits() {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::is_x86_feature_detected as has;
-        // SAFETY (the casts of unsafe fns): called only when the CPU has their features.
-        if has!("avx2") {
-            paths.push((
-                "avx2",
+        // The four passes compiled for one path. SAFETY: pushed only when the CPU has its features.
+        macro_rules! on_path {
+            ($path:ident) => {
                 (
-                    |a, b, c, d, e, f, g, h| unsafe { primitives_paths::avx2(a, b, c, d, e, f, g, h) },
-                    |a, b, c, d, e, f, g| unsafe { gradients_paths::avx2(a, b, c, d, e, f, g) },
-                    |a, b, c, d, e, f| unsafe { axial_paths::avx2(a, b, c, d, e, f) },
-                    |a, b, c, d, e, f, g| unsafe { residual_paths::avx2(a, b, c, d, e, f, g) },
-                ),
-            ));
+                    |a, b, c, d, e, f, g, h| unsafe { primitives_paths::$path(a, b, c, d, e, f, g, h) },
+                    |a, b, c, d, e, f, g| unsafe { gradients_paths::$path(a, b, c, d, e, f, g) },
+                    |a, b, c, d, e, f| unsafe { axial_paths::$path(a, b, c, d, e, f) },
+                    |a, b, c, d, e, f, g| unsafe { residual_paths::$path(a, b, c, d, e, f, g) },
+                )
+            };
+        }
+        if has!("avx2") {
+            paths.push(("avx2", on_path!(avx2)));
         }
         if has!("avx512f") && has!("avx512vl") && has!("avx512dq") {
-            paths.push((
-                "avx512",
-                (
-                    |a, b, c, d, e, f, g, h| unsafe { primitives_paths::avx512(a, b, c, d, e, f, g, h) },
-                    |a, b, c, d, e, f, g| unsafe { gradients_paths::avx512(a, b, c, d, e, f, g) },
-                    |a, b, c, d, e, f| unsafe { axial_paths::avx512(a, b, c, d, e, f) },
-                    |a, b, c, d, e, f, g| unsafe { residual_paths::avx512(a, b, c, d, e, f, g) },
-                ),
-            ));
+            paths.push(("avx512", on_path!(avx512)));
         }
     }
     for outlet in [Outlet::Characteristic, Outlet::Wall] {

@@ -17,7 +17,7 @@ pub struct SquareGrid {
     cube_side_factor: f64,
     scatter: Scatter<()>,
     /// Solid volume per box (layer-major: (k·nb + by)·nb + bx), one buffer per fixed chunk.
-    box_volume: Vec<Vec<f64>>,
+    box_volume: Vec<BoxSums>,
 }
 
 /// Fixed number of particle chunks for the box accumulation (results do not depend on threads).
@@ -61,10 +61,17 @@ impl VoidageMethod for SquareGrid {
 /// The paper's two stages (eq. 8): every particle's cube onto the boxes (≤ 8 boxes per particle,
 /// PHYSICS.md 4), then each box's solid volume onto the cells with the precomputed fractions,
 /// once per call — so the per-particle work does not grow with the cells a box touches.
+/// One chunk's solid volume per box, and the layers it filled this call (the rest is stale).
+#[derive(Clone, Default)]
+struct BoxSums {
+    volume: Vec<f64>,
+    layers: std::ops::Range<usize>,
+}
+
 fn two_stage_cuboid(
     g: &CylGrid,
     bg: &BoxGrid,
-    bufs: &mut Vec<Vec<f64>>,
+    bufs: &mut Vec<BoxSums>,
     positions: &[[f64; 3]],
     radius: f64,
     h: f64,
@@ -73,8 +80,8 @@ fn two_stage_cuboid(
     use rayon::prelude::*;
     let nb = bg.nb;
     let nboxes = nb * nb * g.nz;
-    if bufs.len() != BOX_CHUNKS || bufs[0].len() != nboxes {
-        *bufs = vec![vec![0.0; nboxes]; BOX_CHUNKS];
+    if bufs.len() != BOX_CHUNKS || bufs[0].volume.len() != nboxes {
+        *bufs = vec![BoxSums { volume: vec![0.0; nboxes], layers: 0..0 }; BOX_CHUNKS];
     }
     let vp = 4.0 / 3.0 * PI * radius.powi(3);
     let chunk = positions.len().div_ceil(BOX_CHUNKS).max(1);
@@ -83,61 +90,54 @@ fn two_stage_cuboid(
     // the freeboard holds no solid): cubes span [z − h/2, z + h/2], so layers
     // cell(z_min − h/2) ..= cell(z_max + h/2) of the chunk.
     let up = Axis::new(0.0, g.dz, g.nz);
-    let ranges: Vec<(usize, usize)> = bufs
-        .par_iter_mut()
-        .enumerate()
-        .map(|(n, buf)| {
-            let lo = (n * chunk).min(positions.len());
-            let hi = ((n + 1) * chunk).min(positions.len());
-            let (z_min, z_max) = positions[lo..hi]
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
-            let (k0, k1) = if lo == hi { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
-            buf[k0 * nb * nb..k1 * nb * nb].fill(0.0);
-            let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
-            let across = Axis::new(bg.origin, bg.dl, nb);
-            if h <= bg.dl && h <= g.dz {
-                // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
-                for p in &positions[lo..hi] {
-                    let (sx, sy, sz) =
-                        (split_two(p[0], h, &across), split_two(p[1], h, &across), split_two(p[2], h, &up));
-                    for &(k, wz) in &sz {
-                        for &(by, wy) in &sy {
-                            let row = (k * nb + by) * nb;
-                            for &(bx, wx) in &sx {
-                                buf[row + bx] += vp * wx * wy * wz;
-                            }
-                        }
-                    }
-                }
-                return (k0, k1);
-            }
+    bufs.par_iter_mut().enumerate().for_each(|(n, sums)| {
+        let lo = (n * chunk).min(positions.len());
+        let hi = ((n + 1) * chunk).min(positions.len());
+        let (z_min, z_max) =
+            positions[lo..hi].iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
+        let (k0, k1) = if lo == hi { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
+        sums.layers = k0..k1;
+        let buf = &mut sums.volume;
+        buf[k0 * nb * nb..k1 * nb * nb].fill(0.0);
+        let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
+        let across = Axis::new(bg.origin, bg.dl, nb);
+        if h <= bg.dl && h <= g.dz {
+            // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
             for p in &positions[lo..hi] {
-                let nx = interval_split(p[0], h, &across, &mut fx);
-                let ny = interval_split(p[1], h, &across, &mut fy);
-                let nz = interval_split(p[2], h, &up, &mut fz);
-                for &(k, sz) in &fz[..nz] {
-                    for &(by, sy) in &fy[..ny] {
+                let (sx, sy, sz) = (split_two(p[0], h, &across), split_two(p[1], h, &across), split_two(p[2], h, &up));
+                for &(k, wz) in &sz {
+                    for &(by, wy) in &sy {
                         let row = (k * nb + by) * nb;
-                        for &(bx, sx) in &fx[..nx] {
-                            buf[row + bx] += vp * sx * sy * sz;
+                        for &(bx, wx) in &sx {
+                            buf[row + bx] += vp * wx * wy * wz;
                         }
                     }
                 }
             }
-            (k0, k1)
-        })
-        .collect();
+            return;
+        }
+        for p in &positions[lo..hi] {
+            let nx = interval_split(p[0], h, &across, &mut fx);
+            let ny = interval_split(p[1], h, &across, &mut fy);
+            let nz = interval_split(p[2], h, &up, &mut fz);
+            for &(k, sz) in &fz[..nz] {
+                for &(by, sy) in &fy[..ny] {
+                    let row = (k * nb + by) * nb;
+                    for &(bx, sx) in &fx[..nx] {
+                        buf[row + bx] += vp * sx * sy * sz;
+                    }
+                }
+            }
+        }
+    });
     // boxes → cells, layer by layer (parallel over layers; each layer writes its own cells), from
     // the chunks whose layers include it, in chunk order
     let per = g.cells_per_layer();
     out.par_chunks_mut(per).enumerate().for_each(|(k, layer)| {
         layer.fill(0.0);
         let (mut from, mut m): ([&[f64]; BOX_CHUNKS], usize) = ([&[]; BOX_CHUNKS], 0);
-        for (b, r) in bufs.iter().zip(&ranges) {
-            if (r.0..r.1).contains(&k) {
-                (from[m], m) = (b, m + 1);
-            }
+        for sums in bufs.iter().filter(|s| s.layers.contains(&k)) {
+            (from[m], m) = (&sums.volume, m + 1);
         }
         if m == 0 {
             return;
