@@ -189,7 +189,8 @@ pub fn parts() {
     time("voidage_solid_volume", &mut || method.solid_volume(dem.positions(), dem.radius(), &mut solid));
     time("voidage_from_solid", &mut || voidage_from_solid(grid, &solid, &mut eps));
     let (mut vel, mut rho, mut grad) = (vec![[0.0; 3]; n], vec![0.0; n], vec![[0.0; 3]; n]);
-    time("gas_exchange_fields", &mut || gas.exchange_fields(&mut vel, &mut rho, &mut grad));
+    let layers = fluidbed_core::coupling::layers_with_particles(grid, dem.positions());
+    time("gas_exchange_fields", &mut || gas.exchange_fields(layers, &mut vel, &mut rho, &mut grad));
     let g = case.gas.as_ref().expect("gas");
     let par = ExchangeParams {
         law: case.coupling.drag_law,
@@ -197,7 +198,7 @@ pub fn parts() {
         eps_min: g.drag_voidage_min,
         d: 2.0 * dem.radius(),
     };
-    let at = GasAtCells { velocity_cyl: &vel, density: &rho, grad_p_cyl: &grad, voidage: &eps };
+    let at = GasAtCells { velocity_cyl: &vel, density: &rho, grad_p_cyl: &grad, voidage: &eps, layers };
     let mut ex = Exchange::new(grid, dem.len());
     let (mut f, mut cf) = (vec![[0.0; 3]; dem.len()], vec![[0.0; 3]; n]);
     time("particle_gas_forces", &mut || {

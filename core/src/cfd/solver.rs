@@ -361,10 +361,18 @@ impl GasSolver {
         Ok(())
     }
 
-    /// What the particle–gas exchange reads per cell, for all cells at once (parallel over
-    /// layers): interstitial velocity (U_r, U_θ, U_z), density ρ and ∇p as `pressure_gradient_cyl`.
-    pub fn exchange_fields(&self, velocity_cyl: &mut [[f64; 3]], density: &mut [f64], grad_p_cyl: &mut [[f64; 3]]) {
+    /// What the particle–gas exchange reads per cell, in layers 0..layers (parallel over layers):
+    /// interstitial velocity (U_r, U_θ, U_z), density ρ and ∇p as `pressure_gradient_cyl`.
+    pub fn exchange_fields(
+        &self,
+        layers: usize,
+        velocity_cyl: &mut [[f64; 3]],
+        density: &mut [f64],
+        grad_p_cyl: &mut [[f64; 3]],
+    ) {
         let per = self.grid.cells_per_layer();
+        let n = layers.min(self.grid.nz) * per;
+        let (velocity_cyl, density, grad_p_cyl) = (&mut velocity_cyl[..n], &mut density[..n], &mut grad_p_cyl[..n]);
         let rows = (self.grid.nz / rayon::current_num_threads().max(1)).max(1);
         (velocity_cyl.par_chunks_mut(per), density.par_chunks_mut(per), grad_p_cyl.par_chunks_mut(per))
             .into_par_iter()

@@ -32,6 +32,20 @@ pub struct GasAtCells<'a> {
     /// (∂p/∂r, (1/r)∂p/∂θ, ∂p/∂z).
     pub grad_p_cyl: &'a [[f64; 3]],
     pub voidage: &'a [f64],
+    /// The fields hold values in layers 0..layers, at least every layer that holds a particle
+    /// centre (`layers_with_particles`); the exchange reads and writes no layer above.
+    pub layers: usize,
+}
+
+/// The fluid layers from the bottom up to the one holding the highest particle centre: what the
+/// exchange reads (0 without particles). The freeboard above a bed holds no particle.
+pub fn layers_with_particles(grid: &CylGrid, pos: &[[f64; 3]]) -> usize {
+    let top = pos.iter().map(|p| p[2]).fold(f64::NEG_INFINITY, f64::max);
+    if top.is_finite() {
+        grid.locate_k(top) + 1
+    } else {
+        0
+    }
 }
 
 /// Cylindrical (radial, angular, axial) components at angle θ → Cartesian.
@@ -198,11 +212,14 @@ impl Exchange {
         let drag_cells = drag.grid.num_cells();
         assert!(drag.grid.cells_per_layer() == per && drag_cells == m * cells && drag.voidage.len() == drag_cells);
         self.cell_of.resize(pos.len(), 0);
+        // The drag cells of the layers that hold particles; the cells above get no table and no
+        // force. (Sub-layers read their neighbours' sums: all of them.)
+        let used = if m == 1 { gas.layers.min(grid.nz) * per } else { drag_cells };
         // 1. per drag cell (parallel): everything that does not depend on the particle
         let (mu, d) = (par.mu, par.d);
         table.resize(drag_cells, CellTable::default());
         let basis = &self.cell_basis;
-        table.par_iter_mut().with_min_len(256).enumerate().for_each(|(s, t)| {
+        table[..used].par_iter_mut().with_min_len(256).enumerate().for_each(|(s, t)| {
             let c = (s / per / m) * per + s % per;
             let eps = clamp_voidage(drag.voidage[s], par.eps_min);
             let u = gas.velocity_cyl[c];
@@ -226,7 +243,8 @@ impl Exchange {
         //    (paper section 2.3); the drag, in its cell's basis, summed per chunk for the gas
         let vp = PI * d * d * d / 6.0;
         let chunk = pos.len().div_ceil(CHUNKS).max(1);
-        let table = &table[..];
+        // A particle above the used layers would index past this slice: a panic, never a stale table.
+        let table = &table[..used];
         let (dgrid, cells_d) = (drag.grid, drag_cells);
         self.chunk_force.resize_with(CHUNKS, || vec![[0.0; 3]; cells_d]);
         // Rows of chunks without particles add nothing.
@@ -239,7 +257,7 @@ impl Exchange {
             .enumerate()
             .for_each(|(n, (sum, f, co))| {
                 sum.resize(cells_d, [0.0; 3]);
-                sum.fill([0.0; 3]);
+                sum[..used].fill([0.0; 3]);
                 let lo = n * chunk;
                 particle_block_pass_on::<L>(
                     dgrid,
@@ -272,7 +290,9 @@ impl Exchange {
         let inv_v = 1.0 / grid.cell_volume();
         let sums = &self.chunk_force;
         let lost = &self.sub_lost;
-        cell_force_out.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
+        let (below, above) = cell_force_out.split_at_mut(used / m);
+        above.fill([0.0; 3]);
+        below.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
             let mut s = [0.0; 3];
             let first = (c / per) * m * per + c % per;
             for sub in 0..m {
@@ -506,7 +526,8 @@ mod tests {
         let dens = vec![rho; n];
         let grad = vec![[0.0, 0.0, dpdz]; n];
         let void = vec![eps; n];
-        let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
+        let gas =
+            GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void, layers: usize::MAX };
         let pos = vec![[0.003, -0.007, 0.005], [0.0, 0.0, 0.001], [-0.015, 0.01, 0.012]];
         let vel = vec![[0.1, 0.0, 0.2], [0.0, 0.0, 0.0], [0.0, -0.3, -0.1]];
         let mut f = vec![[0.0; 3]; 3];
@@ -573,7 +594,13 @@ mod tests {
         }
 
         pub(super) fn gas(&self) -> GasAtCells<'_> {
-            GasAtCells { velocity_cyl: &self.vel_c, density: &self.dens, grad_p_cyl: &self.grad, voidage: &self.void }
+            GasAtCells {
+                velocity_cyl: &self.vel_c,
+                density: &self.dens,
+                grad_p_cyl: &self.grad,
+                voidage: &self.void,
+                layers: usize::MAX,
+            }
         }
     }
 
@@ -679,7 +706,8 @@ mod tests {
         let dens: Vec<f64> = (0..n).map(|_| rng.gen_range(1.1..1.3)).collect();
         let grad = vec![[0.0, 0.0, -5000.0]; n];
         let void: Vec<f64> = (0..n).map(|_| rng.gen_range(0.35..1.0)).collect();
-        let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
+        let gas =
+            GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void, layers: usize::MAX };
         let pos: Vec<[f64; 3]> = (0..3000)
             .map(|_| {
                 let (r, t) = (0.021 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
@@ -699,5 +727,54 @@ mod tests {
                 assert!((full[c][m] - fast[c][m]).abs() <= 1e-12 * scale, "cell {c}: {:?} vs {:?}", full[c], fast[c]);
             }
         }
+    }
+
+    /// A bed in the lower layers: the exchange over its layers only (`layers_with_particles`)
+    /// gives the same bits as over the whole column, and the gas above it gets no force, also
+    /// after a call whose particles reached higher (no stale sums).
+    #[test]
+    fn the_layers_with_particles_give_the_same_bits_as_the_whole_column() {
+        let g = grid();
+        let n = g.num_cells();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut scene = RandomScene::new(&mut rng, n, 3000, true);
+        let par = ExchangeParams { law: DragModel::Beetstra, mu: 1.8e-5, eps_min: 0.1, d: 1.2e-3 };
+        let mut ex = Exchange::new(&g, scene.pos.len());
+        let (mut f, mut cf) = (vec![[0.0; 3]; scene.pos.len()], vec![[0.0; 3]; n]);
+        let high = scene.gas();
+        ex.particle_gas_forces(
+            &g,
+            DragCells::cells(&g, high.voidage),
+            &high,
+            par,
+            (&scene.pos, &scene.vel),
+            &mut f,
+            &mut cf,
+        );
+        // the same particles squeezed into the lower half of the column
+        for p in &mut scene.pos {
+            p[2] *= 0.5;
+        }
+        let layers = layers_with_particles(&g, &scene.pos);
+        assert!(layers < g.nz, "the bed leaves layers free");
+        let mut whole = Exchange::new(&g, scene.pos.len());
+        let (mut f_all, mut cf_all) = (f.clone(), cf.clone());
+        let all = scene.gas();
+        let v = all.voidage;
+        whole.particle_gas_forces(
+            &g,
+            DragCells::cells(&g, v),
+            &all,
+            par,
+            (&scene.pos, &scene.vel),
+            &mut f_all,
+            &mut cf_all,
+        );
+        let low = GasAtCells { layers, ..scene.gas() };
+        ex.particle_gas_forces(&g, DragCells::cells(&g, v), &low, par, (&scene.pos, &scene.vel), &mut f, &mut cf);
+        assert!(f == f_all && cf == cf_all, "forces differ");
+        let per = g.cells_per_layer();
+        assert!(cf[layers * per..].iter().all(|c| *c == [0.0; 3]), "force above the bed");
+        assert!(cf[..layers * per].iter().any(|c| *c != [0.0; 3]));
     }
 }

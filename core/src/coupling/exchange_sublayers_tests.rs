@@ -34,7 +34,8 @@ fn a_packed_sublayer_gets_its_share_of_the_pressure_drop() {
     void[c] = e_c;
     let vel_c: Vec<[f64; 3]> = void.iter().map(|e| [0.0, 0.0, u0 / e]).collect();
     let (dens, grad) = (vec![rho; n], vec![[0.0; 3]; n]);
-    let gas = GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void };
+    let gas =
+        GasAtCells { velocity_cyl: &vel_c, density: &dens, grad_p_cyl: &grad, voidage: &void, layers: usize::MAX };
     let (mut f, mut cf) = (vec![[0.0; 3]; pos.len()], vec![[0.0; 3]; n]);
     let par = ExchangeParams { law: DragModel::Beetstra, mu, eps_min: 0.1, d };
     let drag = DragCells { grid: &fine, sublayers: 2, voidage: &sub };

@@ -7,5 +7,5 @@ mod sublayer_pressure;
 pub mod voidage;
 
 pub use drag::{beetstra_f, beta_a, drag_force, DragLaw, DragModel};
-pub use exchange::{DragCells, Exchange, ExchangeParams, GasAtCells};
+pub use exchange::{layers_with_particles, DragCells, Exchange, ExchangeParams, GasAtCells};
 pub use voidage::{build_voidage, voidage_from_solid, VoidageMethod};

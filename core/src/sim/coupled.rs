@@ -8,7 +8,9 @@
 //! (coupling/exchange.rs, `windowed_voidage`).
 
 use super::{watchdog, SimError, Simulation};
-use crate::coupling::{voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod};
+use crate::coupling::{
+    layers_with_particles, voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod,
+};
 use crate::dem::DemSystem;
 use crate::grid::CylGrid;
 
@@ -128,13 +130,16 @@ impl Simulation {
         }
         let t1 = std::time::Instant::now();
         let b = &mut self.buf;
-        gas.exchange_fields(&mut b.cell_velocity, &mut b.cell_density, &mut b.cell_grad_p);
+        // The layers that hold particles (with sub-layers, the drag reads its fluid cells' fields).
+        let layers = layers_with_particles(&self.grid, self.st.dem.positions());
+        gas.exchange_fields(layers, &mut b.cell_velocity, &mut b.cell_density, &mut b.cell_grad_p);
         let g = self.st.case.gas.as_ref().expect("gas section");
         let at = GasAtCells {
             velocity_cyl: &b.cell_velocity,
             density: &b.cell_density,
             grad_p_cyl: &b.cell_grad_p,
             voidage: &b.voidage,
+            layers,
         };
         let dem = &mut self.st.dem;
         let par = ExchangeParams {
