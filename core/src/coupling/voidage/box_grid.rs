@@ -18,6 +18,11 @@ pub struct BoxGrid {
     /// CSR: for box b = by·nb + bx, entries start[b]..start[b+1] of (in-layer cell, fraction).
     start: Vec<usize>,
     entries: Vec<(u32, f64)>,
+    /// CSR by in-layer cell c: whole[whole_start[c]..whole_start[c+1]] are the boxes that lie in c
+    /// alone (fraction 1); `shared` the boxes that share their volume between cells.
+    whole_start: Vec<u32>,
+    whole: Vec<u32>,
+    shared: Vec<u32>,
 }
 
 impl BoxGrid {
@@ -61,7 +66,37 @@ impl BoxGrid {
                 start.push(entries.len());
             }
         }
-        BoxGrid { dl, nb, origin, start, entries }
+        let per = grid.cells_per_layer();
+        let (mut by_cell, mut shared) = (vec![Vec::new(); per], Vec::new());
+        for b in 0..nb * nb {
+            match &entries[start[b]..start[b + 1]] {
+                [(c, f)] if *f == 1.0 => by_cell[*c as usize].push(b as u32),
+                _ => shared.push(b as u32),
+            }
+        }
+        let mut whole_start = vec![0u32];
+        for boxes in &by_cell {
+            whole_start.push(whole_start.last().expect("start") + boxes.len() as u32);
+        }
+        let whole = by_cell.concat();
+        BoxGrid { dl, nb, origin, start, entries, whole_start, whole, shared }
+    }
+
+    /// The boxes (b = by·nb + bx) that lie in in-layer cell c alone.
+    #[inline]
+    pub fn whole_boxes_of(&self, c: usize) -> &[u32] {
+        &self.whole[self.whole_start[c] as usize..self.whole_start[c + 1] as usize]
+    }
+
+    /// The boxes that share their volume between cells (`cells_of_box` gives the shares).
+    pub fn shared_boxes(&self) -> &[u32] {
+        &self.shared
+    }
+
+    /// (in-layer cell, fraction) pairs of box b = by·nb + bx.
+    #[inline]
+    pub fn cells_of_box(&self, b: usize) -> &[(u32, f64)] {
+        &self.entries[self.start[b]..self.start[b + 1]]
     }
 
     /// (in-layer cell, fraction) pairs of box (bx, by); fractions sum to 1.

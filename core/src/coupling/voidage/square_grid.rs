@@ -142,15 +142,28 @@ fn two_stage_cuboid(
         if m == 0 {
             return;
         }
-        let (first, rest) = (from[0], &from[1..m]);
-        for by in 0..nb {
-            for bx in 0..nb {
-                let b = (k * nb + by) * nb + bx;
-                let v: f64 = first[b] + rest.iter().map(|r| r[b]).sum::<f64>();
-                if v != 0.0 {
-                    for &(c, f) in bg.cells_of(bx, by) {
-                        layer[c as usize] += v * f;
-                    }
+        let base = k * nb * nb;
+        let (first, rest) = (&from[0][base..base + nb * nb], &from[1..m]);
+        let v = |b: u32| first[b as usize] + rest.iter().map(|r| r[base + b as usize]).sum::<f64>();
+        // Each cell sums its whole boxes in registers (four running sums), so consecutive boxes of
+        // one cell do not wait on each other through memory; then the shared boxes add their shares.
+        for (c, out) in layer.iter_mut().enumerate() {
+            let boxes = bg.whole_boxes_of(c);
+            let mut acc = [0.0; 4];
+            let mut quads = boxes.chunks_exact(4);
+            for q in &mut quads {
+                for (a, &b) in acc.iter_mut().zip(q) {
+                    *a += v(b);
+                }
+            }
+            let tail: f64 = quads.remainder().iter().map(|&b| v(b)).sum();
+            *out = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + tail;
+        }
+        for &b in bg.shared_boxes() {
+            let vb = v(b);
+            if vb != 0.0 {
+                for &(c, f) in bg.cells_of_box(b as usize) {
+                    layer[c as usize] += vb * f;
                 }
             }
         }
