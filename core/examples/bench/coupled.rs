@@ -324,3 +324,39 @@ pub fn gas_dt() {
         );
     }
 }
+
+/// One gas step taken between DEM steps (the DEM evicts the gas's state from the caches) against
+/// gas steps back to back, one thread and a team (`bench -- gas-context`, a diagnostic).
+pub fn gas_context() {
+    let case = shipped_case("bubbling-44mm.json");
+    let state = state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm");
+    let mut sim = Simulation::restore(&state).expect("state");
+    let dt = sim.plan().gas_dt_s.expect("gas dt");
+    let base = sim.gas().expect("gas").clone();
+    let (mut team, mut one) = (base.clone(), base);
+    one.set_parallel(false);
+    let mut t = [[0.0f64; 2]; 2];
+    for _ in 0..10 {
+        for (m, gas) in [&mut team, &mut one].into_iter().enumerate() {
+            for _ in 0..20 {
+                for _ in 0..3 {
+                    sim.dem_mut().step();
+                }
+                let t0 = Instant::now();
+                gas.step(dt);
+                t[m][0] += t0.elapsed().as_secs_f64();
+            }
+            let t0 = Instant::now();
+            for _ in 0..20 {
+                gas.step(dt);
+            }
+            t[m][1] += t0.elapsed().as_secs_f64();
+        }
+    }
+    println!("team: between DEM steps {:.3} ms, back to back {:.3} ms", t[0][0] / 200.0 * 1e3, t[0][1] / 200.0 * 1e3);
+    println!(
+        "one thread: between DEM steps {:.3} ms, back to back {:.3} ms",
+        t[1][0] / 200.0 * 1e3,
+        t[1][1] / 200.0 * 1e3
+    );
+}

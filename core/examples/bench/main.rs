@@ -24,6 +24,7 @@ fn run(what: &str) {
         "cfd" => cfd::run(),
         "coupled" => coupled::run(),
         "coupled-parts" => coupled::parts(),
+        "gas-context" => coupled::gas_context(),
         "gas-team" => coupled::gas_team(),
         "coupled-micro" => coupled::micro(),
         "gas-dt" => coupled::gas_dt(),

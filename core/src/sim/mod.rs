@@ -198,17 +198,21 @@ impl Simulation {
             }
             self.step()?;
             if self.st.analysis.due(self.st.steps, self.st.dem.time()) {
+                self.sync_gas()?;
                 let t0 = std::time::Instant::now();
                 self.sample_analysis();
                 self.timers.output += t0.elapsed().as_secs_f64();
             }
             if self.st.steps.is_multiple_of(self.steps_per_snapshot) || self.st.steps == self.end_steps {
+                self.sync_gas()?;
                 let t0 = std::time::Instant::now();
                 let s = self.take_snapshot();
                 self.timers.output += t0.elapsed().as_secs_f64();
                 return s.map(Some);
             }
         }
+        // Whoever reads the state next (a checkpoint, `gas()`) sees the gas at the particles' time.
+        self.sync_gas()?;
         Ok(None)
     }
 
