@@ -102,8 +102,7 @@ impl BoxGrid {
     /// (in-layer cell, fraction) pairs of box (bx, by); fractions sum to 1.
     #[inline]
     pub fn cells_of(&self, bx: usize, by: usize) -> &[(u32, f64)] {
-        let b = by * self.nb + bx;
-        &self.entries[self.start[b]..self.start[b + 1]]
+        self.cells_of_box(by * self.nb + bx)
     }
 
     /// Area of box (bx, by) inside the column (for the tiling test).

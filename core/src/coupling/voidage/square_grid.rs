@@ -58,9 +58,6 @@ impl VoidageMethod for SquareGrid {
     }
 }
 
-/// The paper's two stages (eq. 8): every particle's cube onto the boxes (≤ 8 boxes per particle,
-/// PHYSICS.md 4), then each box's solid volume onto the cells with the precomputed fractions,
-/// once per call — so the per-particle work does not grow with the cells a box touches.
 /// One chunk's solid volume per box, and the layers it filled this call (the rest is stale).
 #[derive(Clone, Default)]
 struct BoxSums {
@@ -68,6 +65,9 @@ struct BoxSums {
     layers: std::ops::Range<usize>,
 }
 
+/// The paper's two stages (eq. 8): every particle's cube onto the boxes (≤ 8 boxes per particle,
+/// PHYSICS.md 4), then each box's solid volume onto the cells with the precomputed fractions,
+/// once per call — so the per-particle work does not grow with the cells a box touches.
 fn two_stage_cuboid(
     g: &CylGrid,
     bg: &BoxGrid,
