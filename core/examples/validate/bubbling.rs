@@ -153,12 +153,6 @@ struct Progress {
     wall_s: f64,
 }
 
-fn write_atomically(path: &str, bytes: &[u8]) {
-    let tmp = format!("{path}.tmp");
-    std::fs::write(&tmp, bytes).unwrap_or_else(|e| panic!("{tmp}: {e}"));
-    std::fs::rename(&tmp, path).unwrap_or_else(|e| panic!("{path}: {e}"));
-}
-
 pub fn run() -> serde_json::Value {
     let r = run_to(end_s());
     let case = case();

@@ -127,3 +127,10 @@ pub fn expected_dp(case: &fluidbed_core::case::Case, particles: usize) -> (f64, 
     let grid = fluidbed_core::sim::fluid_grid(case);
     (bed_weight_per_area(case, particles, rho_g), rho_g * case.gravity_m_s2 * (grid.nz - 1) as f64 * grid.dz)
 }
+
+/// Write `bytes` to `path` through a temporary file, so a stopped run never leaves half a file.
+pub fn write_atomically(path: &str, bytes: &[u8]) {
+    let tmp = format!("{path}.tmp");
+    std::fs::write(&tmp, bytes).unwrap_or_else(|e| panic!("{tmp}: {e}"));
+    std::fs::rename(&tmp, path).unwrap_or_else(|e| panic!("{path}: {e}"));
+}
