@@ -73,6 +73,21 @@ pub struct Coupling {
     /// than the cells (docs/VALIDATION.md, "U_mf with the paper's cells and the drag voidage on sub-layers").
     #[serde(default = "d_drag_sublayers")]
     pub drag_voidage_sublayers: u32,
+    /// The gas's voidage between couplings: "held" (the paper's: each coupling's field at once;
+    /// the gas mass of each cell is held, so the change shows as a pressure step) or
+    /// "interpolated" (from the previous coupling's field to the new one over the next interval,
+    /// one interval behind the particles and without steps; cfd/voidage_ramp.rs).
+    #[serde(default)]
+    pub gas_voidage: GasVoidage,
+}
+
+/// How the gas's voidage moves between couplings (`coupling.gas_voidage`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GasVoidage {
+    #[default]
+    Held,
+    Interpolated,
 }
 
 impl Default for Coupling {
@@ -81,6 +96,7 @@ impl Default for Coupling {
             drag_law: Default::default(),
             interval_steps: d_coupling_interval(),
             drag_voidage_sublayers: d_drag_sublayers(),
+            gas_voidage: GasVoidage::Held,
         }
     }
 }

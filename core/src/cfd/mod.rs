@@ -67,6 +67,7 @@ mod smart;
 mod solver;
 mod stability;
 mod team_step;
+mod voidage_ramp;
 
 #[cfg(test)]
 mod tests;
@@ -80,3 +81,4 @@ pub use rhs::FACE_FLUX_RATE;
 pub use smart::smart_face;
 pub use solver::GasSolver;
 pub use stability::{case_stable_time_step, cell_stable_dt};
+pub use voidage_ramp::VoidageRamp;

@@ -10,6 +10,7 @@ use super::rhs::{inlet_face_pressure, net_mass_inflow, top_face_pressure, Primit
 use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
 use super::stability::cell_stable_dt;
 use super::team_step::{fits, team_step, StepInput, StepState};
+use super::voidage_ramp::VoidageRamp;
 use crate::case::Case;
 use crate::grid::CylGrid;
 use crate::team::TeamLock;
@@ -72,6 +73,9 @@ pub struct GasSolver {
     pressure_offset: f64,
     /// The mass budget of the flux-updated cells (mass_budget.rs); checkpointed beside the state.
     budget: MassBudget,
+    /// The gas's voidage between couplings when interpolated (voidage_ramp.rs); checkpointed
+    /// beside the state.
+    ramp: Option<VoidageRamp>,
 }
 
 /// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
@@ -142,6 +146,7 @@ impl GasSolver {
             team: true,
             pressure_offset: 0.0,
             budget: MassBudget::default(),
+            ramp: None,
             grid,
         }
     }
@@ -202,6 +207,19 @@ impl GasSolver {
     pub fn set_voidage(&mut self, eps: &[f64]) {
         assert_eq!(eps.len(), self.st.eps.len(), "one voidage per cell");
         self.st.eps.copy_from_slice(eps);
+        self.ramp = None;
+    }
+    /// Voidage per cell reached over the `span` seconds from `start` (the coupling's time),
+    /// starting from the previous ramp's end (voidage_ramp.rs); each step takes ε at its start.
+    pub fn ramp_voidage(&mut self, eps: &[f64], start: f64, span: f64) {
+        self.ramp = Some(VoidageRamp::next(self.ramp.take(), &self.st.eps, eps, start, span));
+    }
+    /// The voidage ramp (checkpoints).
+    pub fn voidage_ramp(&self) -> Option<&VoidageRamp> {
+        self.ramp.as_ref()
+    }
+    pub fn set_voidage_ramp(&mut self, ramp: Option<VoidageRamp>) {
+        self.ramp = ramp;
     }
     pub fn voidage(&self) -> &[f64] {
         &self.st.eps
@@ -392,6 +410,9 @@ impl GasSolver {
     /// The face corrections F are integrated with the cell state by the same scheme. A multistep
     /// step runs as one team of threads (team_step.rs) when the pool is free for one.
     pub fn step(&mut self, dt: f64) {
+        if let Some(r) = &self.ramp {
+            r.at(self.st.time, &mut self.st.eps);
+        }
         self.start_mass_budget();
         if self.st.hist_len > 0 && self.parallel && self.team && fits(self.grid.nz, rayon::current_num_threads()) {
             if let Some(_team) = TeamLock::try_take() {

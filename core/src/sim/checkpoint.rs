@@ -9,7 +9,8 @@
 //! Formats: 1–3 had no header (one bincode blob after the number); 4 is this layout; 5 adds the
 //! DEM pair pass's chunk cuts to the `dem` section. The `analysis` section (the run's analysis
 //! samples) is optional: a file without it resumes with an empty analysis window; so is
-//! `gas_mass_budget` (cfd/mass_budget.rs): without it the budget starts at the resumed state.
+//! `gas_mass_budget` (cfd/mass_budget.rs): without it the budget starts at the resumed state; and
+//! `gas_voidage_ramp` (cfd/voidage_ramp.rs): without it the gas holds its voidage.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -53,6 +54,7 @@ pub(super) fn encode(st: &State) -> Vec<u8> {
         part("gas", "bincode-1", bincode_of(&st.gas), &[]),
         part("analysis", "bincode-1", bincode_of(&st.analysis), &[]),
         part("gas_mass_budget", "bincode-1", bincode_of(&st.gas.as_ref().map(|g| g.mass_budget())), &[]),
+        part("gas_voidage_ramp", "bincode-1", bincode_of(&st.gas.as_ref().and_then(|g| g.voidage_ramp())), &[]),
     ];
     let header =
         Header { format: FORMAT, writer: WRITER.into(), sections: parts.iter().map(|p| p.0.clone()).collect() };
@@ -132,6 +134,14 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
             g.set_mass_budget(b);
         }
     }
+    // A checkpoint from before the voidage ramp (or of a run without one) holds the voidage.
+    if let Some(body) = sections.get("gas_voidage_ramp") {
+        let ramp: Option<crate::cfd::VoidageRamp> =
+            bincode::deserialize(body).map_err(|e| refuse("gas_voidage_ramp", e.to_string()))?;
+        if let Some(g) = gas.as_mut() {
+            g.set_voidage_ramp(ramp);
+        }
+    }
     // A checkpoint from before the run analysis starts its window afresh.
     let analysis = match sections.get("analysis") {
         Some(body) => bincode::deserialize(body).map_err(|e| refuse("analysis", e.to_string()))?,
@@ -177,7 +187,10 @@ mod tests {
         let (header, sections) = describe(&bytes).unwrap();
         assert_eq!((header.format, header.writer.as_str()), (FORMAT, WRITER));
         let names: Vec<&str> = header.sections.iter().map(|s| s.name.as_str()).collect();
-        assert_eq!(names, ["case", "plan", "counters", "dem", "gas", "analysis", "gas_mass_budget"]);
+        assert_eq!(
+            names,
+            ["case", "plan", "counters", "dem", "gas", "analysis", "gas_mass_budget", "gas_voidage_ramp"]
+        );
         let dem = header.sections.iter().find(|s| s.name == "dem").unwrap();
         assert_eq!(dem.shapes["positions"], [4, 3]);
         assert_eq!(sections["dem"].len() as u64, dem.bytes);
@@ -188,8 +201,12 @@ mod tests {
         assert_eq!(budget(&back), budget(&sim));
         // A section that no longer matches is refused with its name, shapes and both versions.
         let mut bad = bytes.clone();
-        let cut =
-            bad.len() - sections["gas_mass_budget"].len() - sections["analysis"].len() - sections["gas"].len() - 8;
+        let cut = bad.len()
+            - sections["gas_voidage_ramp"].len()
+            - sections["gas_mass_budget"].len()
+            - sections["analysis"].len()
+            - sections["gas"].len()
+            - 8;
         bad.truncate(cut);
         let err = Simulation::restore(&bad).err().unwrap().to_string();
         assert!(err.contains("section dem cut short"), "{err}");

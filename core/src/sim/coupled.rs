@@ -8,6 +8,7 @@
 //! (coupling/exchange.rs, `windowed_voidage`).
 
 use super::{watchdog, SimError, Simulation};
+use crate::case::GasVoidage;
 use crate::coupling::{
     layers_with_particles, voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod,
 };
@@ -122,7 +123,12 @@ impl Simulation {
         let per_particle = moving || self.buf.sub.is_some();
         if moving || !self.buf.voidage_fresh {
             compute_voidage(&self.grid, self.voidage.as_mut(), &self.st.dem, &mut self.buf);
-            gas.set_voidage(&self.buf.voidage);
+            let interval = self.st.plan.coupling_interval as f64 * self.st.case.dem.time_step_s;
+            if moving && self.st.case.coupling.gas_voidage == GasVoidage::Interpolated {
+                gas.ramp_voidage(&self.buf.voidage, self.st.steps as f64 * self.st.case.dem.time_step_s, interval);
+            } else {
+                gas.set_voidage(&self.buf.voidage);
+            }
             if !moving {
                 self.buf.exchange.freeze(&self.grid, self.st.dem.positions());
             }

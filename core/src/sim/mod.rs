@@ -280,7 +280,10 @@ impl Simulation {
         }
         // A coupled run holds the voidage of its last coupling, which the gas holds too.
         match (&sim.st.gas, sim.st.plan.coupling) {
-            (Some(gas), true) => sim.buf.voidage.copy_from_slice(gas.voidage()),
+            (Some(gas), true) => {
+                let held = gas.voidage_ramp().map_or(gas.voidage(), |r| r.target());
+                sim.buf.voidage.copy_from_slice(held)
+            }
             _ => sim.refresh_voidage_field(),
         }
         Ok(sim)

@@ -58,6 +58,14 @@ fn resume_with_a_slowed_acoustic_speed_reports_the_same_absolute_pressures() {
     assert!(max < 1e3, "pressures {max} Pa from the outlet's {p_out} Pa: the offset is lost");
 }
 
+#[test]
+fn resume_with_the_gas_voidage_interpolated_is_bit_identical() {
+    // The cut falls inside a voidage ramp, which the checkpoint must carry.
+    let mut c = case();
+    c.coupling.gas_voidage = crate::case::GasVoidage::Interpolated;
+    resume_is_bit_identical(c);
+}
+
 /// Run `case` straight and with a checkpoint and restore at `CUT`: the snapshots and the final
 /// state are the same bits. Returns the snapshots.
 fn resume_is_bit_identical(case: Case) -> Vec<Snapshot> {
@@ -116,10 +124,21 @@ fn resume_is_bit_identical(case: Case) -> Vec<Snapshot> {
 /// coupling (`sync_gas`). Both give the same snapshots and the same final state, bit for bit.
 #[test]
 fn the_gas_caught_up_at_couplings_gives_the_same_bits_as_step_by_step() {
+    caught_up_equals_step_by_step(case());
+}
+
+#[test]
+fn with_the_gas_voidage_interpolated_the_gas_caught_up_at_couplings_gives_the_same_bits() {
+    let mut c = case();
+    c.coupling.gas_voidage = crate::case::GasVoidage::Interpolated;
+    caught_up_equals_step_by_step(c);
+}
+
+fn caught_up_equals_step_by_step(case: Case) {
     let pool = crate::dem::solver_pool().num_threads(2).build().unwrap();
     pool.install(|| {
         let steps = 340;
-        let mut c = case();
+        let mut c = case;
         c.end_time_s = steps as f64 * c.dem.time_step_s;
         let (mut lazy, mut eager) = (Simulation::new(c.clone(), None).unwrap(), Simulation::new(c, None).unwrap());
         let (mut a, mut b) = (Vec::new(), Vec::new());

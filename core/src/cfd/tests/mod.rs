@@ -10,3 +10,4 @@ mod porous_zone;
 mod support;
 mod team;
 mod validation;
+mod voidage_in_time;
