@@ -164,6 +164,11 @@ impl Simulation {
         self.st.case.coupling.interval_steps = steps.max(1);
         self.st.plan.coupling_interval = steps.max(1) as u64;
     }
+    /// How the gas's voidage moves between couplings from the next coupling on (the trade-off
+    /// bench compares both from one state).
+    pub fn set_gas_voidage(&mut self, how: crate::case::GasVoidage) {
+        self.st.case.coupling.gas_voidage = how;
+    }
     /// Change the set superficial velocity from now on (no new ramp); used by the U_mf sweep.
     pub fn set_superficial_velocity(&mut self, u: f64) {
         if let Some(g) = self.st.case.gas.as_mut() {
