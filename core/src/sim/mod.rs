@@ -181,6 +181,11 @@ impl Simulation {
     pub fn time(&self) -> f64 {
         self.st.steps as f64 * self.st.case.dem.time_step_s
     }
+    /// Run to `t` seconds instead of the case's end (a longer run from the same state).
+    pub fn set_end_time(&mut self, t: f64) {
+        self.st.case.end_time_s = t;
+        self.end_steps = ((t / self.st.case.dem.time_step_s).round() as u64).max(1);
+    }
     pub fn end_time(&self) -> f64 {
         self.end_steps as f64 * self.st.case.dem.time_step_s
     }
