@@ -131,6 +131,17 @@ pub const PRESSURE_DISSIPATION: f64 = 0.05;
 /// most a/(δ√(1 − s₀)) (stability.rs); the steady state does not depend on it.
 pub const FACE_FLUX_RATE: f64 = 0.1;
 
+/// Drag-weighted part of a face pressure, p_f = ½(p_a + p_b) + w (body-force weighting, as
+/// Mencinger & Žun 2007 for a discontinuous body force on a collocated grid): w = ¼(G_a − G_b)·d,
+/// G = −β j_f/ε² each cell's drag-balance gradient −βu/ε at the face's superficial velocity
+/// j_f = ½(ε_a u_a + ε_b u_b) (continuous across a voidage jump), so w = ¼(B_b − B_a)(j_f·d),
+/// B = β/ε². Where β or ε jumps (a bed surface) each cell's Green–Gauss gradient is then its own
+/// drag balance and no odd–even pressure mode is needed; for smooth B it is O(d²), in drag-free gas 0.
+#[inline(always)]
+pub fn drag_weighted_face_pressure(b_a: f64, b_b: f64, jf_dot_d: f64) -> f64 {
+    0.25 * (b_b - b_a) * jf_dot_d
+}
+
 /// Pressure on the inlet face: p·exp(g z/a²) (constant in the hydrostatic state) extrapolated
 /// linearly from layers 0 and 1, φ_f = (3p₀ − p₁e)/2 with e = exp(g dz/a²), then p_f = φ_f·√e.
 /// Exact for the hydrostatic state and for a linear p (a bed's drag gradient, which a zero-gradient
