@@ -126,6 +126,9 @@ impl RhsInput<'_> {
 /// Coefficient κ of the pressure dissipation in the mass flux (module comment).
 pub const PRESSURE_DISSIPATION: f64 = 0.05;
 
+/// Coefficient κ_m of the momentum dissipation in the axial faces' flux of ρεu_z (module comment).
+pub const MOMENTUM_DISSIPATION: f64 = 0.05;
+
 /// Rate factor s₀ of the face mass-flux correction (module comment): it sets the frequency of the
 /// odd–even mode, ω ≤ 2a√s/δ, and raises the acoustic spectral radius of the central scheme to at
 /// most a/(δ√(1 − s₀)) (stability.rs); the steady state does not depend on it.

@@ -11,7 +11,7 @@ use super::geometry::HFace;
 use super::params::Outlet;
 use super::rhs::{
     drag_weighted_face_pressure, face_flux_rate, inlet_face_pressure, inlet_mass_flux, top_face_pressure, PrimView,
-    RhsInput, PRESSURE_DISSIPATION,
+    RhsInput, MOMENTUM_DISSIPATION, PRESSURE_DISSIPATION,
 };
 use super::smart::smart_face;
 
@@ -176,6 +176,18 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)];
     let (vx, vy, vz) = (four(pr.ux), four(pr.uy), four(pr.uz));
     let ff = &inp.face_flux[lo * per..(lo + 1) * per];
+    // ρεu_z of the four layers for the momentum dissipation; beyond the ends the linear ghosts
+    // 2m_in − m_0 (inlet flux ρ_f U) and 2m_top − m_below.
+    let mz = |k: usize, c: usize| q[k * per + c][3];
+    let ghost_below = |c: usize| {
+        if k >= 1 {
+            mz(k - 1, c)
+        } else {
+            2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - mz(0, c)
+        }
+    };
+    let ghost_above = |c: usize| if k + 2 < nz { mz(k + 2, c) } else { 2.0 * mz(k + 1, c) - mz(k, c) };
+    let km = MOMENTUM_DISSIPATION * par.sound_speed;
     let (out, out_fz) = (&mut out[..per], &mut out_fz[..per]);
     let (az, a, dz) = (geo.area_z, par.sound_speed, inp.dz);
     let kd = PRESSURE_DISSIPATION / par.sound_speed;
@@ -196,11 +208,13 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
         let up = mflux >= 0.0;
         let (fx, fy, fz) = (upwind_face(up, &vx, c), upwind_face(up, &vy, c), upwind_face(up, &vz, c));
         let lam = lam_coef * 0.5 * (d_lo[c] + d_hi[c]) * az;
+        // Momentum mismatch (m_hi − m_lo) − ½(∇m_lo + ∇m_hi)·dz = −¼ × the third difference.
+        let mis_m = -0.25 * (ghost_above(c) - 3.0 * q_hi[c][3] + 3.0 * q_lo[c][3] - ghost_below(c));
         out[c] = [
             mflux,
             mflux * fx,
             mflux * fy,
-            mflux * fz,
+            mflux * fz - km * az * mis_m,
             m * (vx[2][c] - vx[1][c]),
             m * (vy[2][c] - vy[1][c]),
             m * (vz[2][c] - vz[1][c]) + lam,
