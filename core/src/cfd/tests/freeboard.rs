@@ -58,10 +58,22 @@ fn run(t_end: f64, from: f64, top: impl Fn(f64) -> f64, scale: impl Fn(f64) -> f
 
 #[test]
 fn the_freeboard_above_a_steady_zone_has_no_odd_even_ripple() {
+    // Before the drag-weighted face pressure and κ_m: 9.62 Pa, the even layers 9.6 Pa low.
     let (s, oe) = run(0.15, 0.1, |_| 1.0, |_| 1.0);
-    let p = s.pressure();
-    let layers: Vec<String> = (0..NZ).map(|k| format!("{:.2}", layer_mean(&s, k, |c| p[c]))).collect();
-    eprintln!("steady zone: freeboard odd-even {oe:.3} Pa; layers {layers:?}");
+    let (p, per) = (s.pressure(), s.grid().cells_per_layer());
+    let layers: Vec<f64> = (0..NZ).map(|k| layer_mean(&s, k, |c| p[c])).collect();
+    let gz = |k: usize| (0..per).map(|c| s.pressure_gradient_cyl(k * per + c)[2]).sum::<f64>() / per as f64;
+    let bed = (layers[2] - layers[4]) / (2.0 * s.grid().dz);
+    eprintln!(
+        "steady zone: freeboard odd-even {oe:.3} Pa; -dp/dz {bed:.1} Pa/m in the zone, cell gradients layers 4-7 {:?}; \
+         layers {:?}",
+        (4..8).map(|k| format!("{:.1}", gz(k))).collect::<Vec<_>>(),
+        layers.iter().map(|v| format!("{v:.2}")).collect::<Vec<_>>()
+    );
+    assert!(oe < 0.5, "freeboard odd-even {oe:.3} Pa");
+    // The zone's top cell has its own drag balance as its gradient, the first free cell ~ρg.
+    assert!((-gz(5) / bed - 1.0).abs() < 0.02, "top zone cell: {:.1} against {bed:.1} Pa/m", -gz(5));
+    assert!(gz(6).abs() < 0.02 * bed, "first free cell: {:.1} Pa/m (zone {bed:.1})", gz(6));
 }
 
 #[test]
@@ -71,4 +83,5 @@ fn the_freeboard_above_a_varying_zone_has_no_odd_even_ripple() {
     let scale = |t: f64| 1.0 + 0.3 * (2.0 * std::f64::consts::PI * 20.0 * t).sin();
     let (_, oe) = run(0.2, 0.1, top, scale);
     eprintln!("varying zone: freeboard odd-even {oe:.3} Pa");
+    assert!(oe < 0.5, "freeboard odd-even {oe:.3} Pa");
 }
