@@ -55,8 +55,7 @@ pub fn run() {
         let k0 = (((top + 2.0 * d) / grid.dz).ceil() as usize).min(nz - 1);
         let oe = odd_even_amplitude(&layer, k0, nz - 1);
         let off = layer[nz - 1] - p_out;
-        let diffs: Vec<String> =
-            (k0..(k0 + 4).min(nz - 1)).map(|k| format!("{:+.3}", layer[k + 1] - layer[k])).collect();
+        let diffs: Vec<String> = (k0..nz - 1).map(|k| format!("{:+.3}", layer[k + 1] - layer[k])).collect();
         println!(
             "{}",
             json!({"t_s": t, "freeboard_from_layer": k0, "layers": nz, "odd_even_pa": oe, "outlet_offset_pa": off,

@@ -35,6 +35,9 @@ pub struct Neighbour {
     pub c: u32,
     pub sx: f64,
     pub sy: f64,
+    /// Centre-to-centre vector to the neighbour, x_nb − x_c.
+    pub dx: f64,
+    pub dy: f64,
 }
 
 /// Geometry shared by all layers.
@@ -125,8 +128,8 @@ impl FaceGeometry {
         let mut lists: Vec<Vec<Neighbour>> = vec![Vec::new(); per];
         let mut lap = vec![0.0; per];
         for f in &faces {
-            lists[f.a as usize].push(Neighbour { c: f.b, sx: f.sx, sy: f.sy });
-            lists[f.b as usize].push(Neighbour { c: f.a, sx: -f.sx, sy: -f.sy });
+            lists[f.a as usize].push(Neighbour { c: f.b, sx: f.sx, sy: f.sy, dx: f.dx, dy: f.dy });
+            lists[f.b as usize].push(Neighbour { c: f.a, sx: -f.sx, sy: -f.sy, dx: -f.dx, dy: -f.dy });
             lap[f.a as usize] += f.area_over_delta;
             lap[f.b as usize] += f.area_over_delta;
         }

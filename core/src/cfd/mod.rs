@@ -15,7 +15,7 @@
 //!
 //! Face mass flux (rhs.rs): ṁ = [½(m_a + m_b) + F]·|S| − (κ/a)ε_f|S|·m, with the pressure mismatch
 //! m = (p_b − p_a) − ½(∇p_a + ∇p_b)·d (zero for any linear p and, to O(dz³), for the hydrostatic
-//! state). Central fluxes alone leave an odd–even pressure mode: the weak κ = 0.05 dissipation
+//! state). Central fluxes alone leave an odd–even pressure mode: the weak κ = 0.1 dissipation
 //! damps it in time, but in a drag-dominated bed the steady state kept it (layer drops alternating
 //! ±69 % of the Beetstra value at ε = 0.727, ±90 % at ε = 0.4; cfd/tests/layer_pressure.rs).
 //! F is a momentum-interpolation (Rhie–Chow) correction carried as state on every face with its
@@ -28,10 +28,27 @@
 //! s = s₀/(1 + β_f δ/(ρ_f ε_f a)), s₀ = 0.1, keeps its frequency and its relaxation rate below
 //! a/δ; the central scheme's acoustic bound becomes a/√(1 − s₀) (stability.rs). F is antisymmetric
 //! per face (mass is conserved to round-off), vanishes in free stream and at rest, decays to zero in
-//! drag-free gas (β = 0: there κ alone handles the mode, which the characteristic outlet is tuned
-//! for: with F there the outlet reflected 1.7–1.9 % instead of 0.87 %), and is off on the face into
-//! the outlet layer. Where ε jumps from a bed to drag-free gas the layer pair at the jump is still
-//! off by a few per cent (the jump is resolved over one cell); the odd–even mode is gone.
+//! drag-free gas (β = 0: there κ and κ_m below handle the mode; with F there the characteristic
+//! outlet reflected 1.7–1.9 %), and is off on the face into
+//! the outlet layer.
+//!
+//! Where the drag jumps (a bed surface, a bubble's edge), the central gradient of a cell next to the
+//! jump sees half of its neighbour's drag gradient; a free cell cannot balance that, so the steady
+//! state used to hold an odd–even mode above a bed (issue 22, item 6a: ±9 Pa in the quickstart's
+//! freeboard), which in free gas κ alone decays only over dz·√(a/(8κU)), ~40 layers. Two terms
+//! remove it, both zero for smooth fields:
+//! - Drag-weighted face pressure in the Green–Gauss gradient (body-force weighting, Mencinger & Žun,
+//!   J. Comput. Phys. 221, 2007): p_f = ½(p_a + p_b) + ¼(B_b − B_a)(j_f·d), B = β/ε², j_f the mean
+//!   superficial velocity εu (rhs.rs `drag_weighted_face_pressure`). Each cell's gradient is then its
+//!   own drag balance −βu/ε, across ε jumps as well; O(d²) for smooth β/ε²; zero in drag-free gas;
+//!   independent of the odd–even part of u (it uses the face mean), so the drag still damps that.
+//!   `pressure_gradient_cyl` (the particles' −V_p∇p) uses the same face pressures.
+//! - Momentum dissipation κ_m on the axial faces' flux of ρεu_z: −κ_m a|S|·[(m_b − m_a) −
+//!   ½(∇m_a + ∇m_b)·d] = +¼κ_m a|S|·δ³m (third difference), the ρεu_z half of the low-Mach Roe
+//!   dissipation |A| = aI whose ρ half is κ, κ_m = κ = 0.1. With both, the odd–even envelope decays
+//!   over dz/(4√(κκ_m)), 2.5 layers, and the outlet reflects 0.12 % instead of 0.87 % (the
+//!   dissipation then acts on both characteristics alike). In a bed's steady state ρεu is uniform
+//!   (the weighted gradient gives every cell its drag balance), so κ_m leaves the drop alone.
 //!
 //! Boundaries:
 //! - Tube wall (r = R): full slip. No mass, momentum or viscous flux; the wall pressure is the

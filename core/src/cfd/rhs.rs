@@ -8,13 +8,17 @@
 //! Per face (vector area S from a to b):
 //! - mass flux ṁ = ½(m_a + m_b)·S (central);
 //! - convective momentum flux ṁ·u_f, u_f central in r and θ, QUICK+SMART in z (paper 2.2; PHYSICS.md 6);
-//! - pressure −ε∇p by Green–Gauss with face value ½(p_a + p_b), model A (PHYSICS.md 11);
+//! - pressure −ε∇p by Green–Gauss with face value ½(p_a + p_b) + ¼(B_b − B_a)(j_f·d), B = β/ε²
+//!   (drag-weighted, `drag_weighted_face_pressure`; zero in drag-free gas), model A (PHYSICS.md 11);
 //! - a pressure dissipation in the mass flux against the odd–even decoupling of collocated central
 //!   schemes (Rhie–Chow type): ṁ −= (κ/a)ε_f|S|[(p_b − p_a) − ½(∇p_a + ∇p_b)·d], d = x_b − x_a,
-//!   ε_f the mean voidage of the two cells (keeps its damping rate 4κa/dz independent of ε), κ = 0.05.
+//!   ε_f the mean voidage of the two cells (keeps its damping rate 4κa/dz independent of ε), κ = 0.1.
 //!   It vanishes for any linear pressure field and scales as κ a dz³∂⁴ρ on smooth waves; without it,
 //!   half the acoustic modes of a column with the characteristic outlet are undamped and the
 //!   linearly extrapolated inlet pressure makes some grow (semi-discrete eigenvalues; see the report);
+//! - on the axial faces a momentum dissipation in the flux of ρεu_z, −κ_m a|S|[(m_b − m_a) −
+//!   ½(∇m_a + ∇m_b)·d], m = ρεu_z, ∇m central (linear ghosts beyond the inlet and outlet), κ_m = 0.1:
+//!   O(dz³∂³m), the ρεu half of the low-Mach Roe dissipation (cfd/mod.rs);
 //! - plus the face correction F·|S| (state, one per face), the Rhie–Chow momentum interpolation whose
 //!   steady value is the Darcy flux of the same mismatch (cfd/mod.rs "Face mass flux");
 //! - stress ε∇·τ with τ = μ(∇u + ∇uᵀ) + (L − 2μ/3)(∇·u)I; for constant μ, ∇·τ = μ∇²u + (L + μ/3)∇(∇·u),
@@ -124,12 +128,27 @@ impl RhsInput<'_> {
 }
 
 /// Coefficient κ of the pressure dissipation in the mass flux (module comment).
-pub const PRESSURE_DISSIPATION: f64 = 0.05;
+pub const PRESSURE_DISSIPATION: f64 = 0.1;
+
+/// Coefficient κ_m of the momentum dissipation in the axial faces' flux of ρεu_z (module comment);
+/// κ_m = κ keeps the outlet's reflection at its smooth level (0.12 %).
+pub const MOMENTUM_DISSIPATION: f64 = 0.1;
 
 /// Rate factor s₀ of the face mass-flux correction (module comment): it sets the frequency of the
 /// odd–even mode, ω ≤ 2a√s/δ, and raises the acoustic spectral radius of the central scheme to at
 /// most a/(δ√(1 − s₀)) (stability.rs); the steady state does not depend on it.
 pub const FACE_FLUX_RATE: f64 = 0.1;
+
+/// Drag-weighted part of a face pressure, p_f = ½(p_a + p_b) + w (body-force weighting, as
+/// Mencinger & Žun 2007 for a discontinuous body force on a collocated grid): w = ¼(G_a − G_b)·d,
+/// G = −β j_f/ε² each cell's drag-balance gradient −βu/ε at the face's superficial velocity
+/// j_f = ½(ε_a u_a + ε_b u_b) (continuous across a voidage jump), so w = ¼(B_b − B_a)(j_f·d),
+/// B = β/ε². Where β or ε jumps (a bed surface) each cell's Green–Gauss gradient is then its own
+/// drag balance and no odd–even pressure mode is needed; for smooth B it is O(d²), in drag-free gas 0.
+#[inline(always)]
+pub fn drag_weighted_face_pressure(b_a: f64, b_b: f64, jf_dot_d: f64) -> f64 {
+    0.25 * (b_b - b_a) * jf_dot_d
+}
 
 /// Pressure on the inlet face: p·exp(g z/a²) (constant in the hydrostatic state) extrapolated
 /// linearly from layers 0 and 1, φ_f = (3p₀ − p₁e)/2 with e = exp(g dz/a²), then p_f = φ_f·√e.

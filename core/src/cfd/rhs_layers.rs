@@ -10,7 +10,8 @@
 use super::geometry::HFace;
 use super::params::Outlet;
 use super::rhs::{
-    face_flux_rate, inlet_face_pressure, inlet_mass_flux, top_face_pressure, PrimView, RhsInput, PRESSURE_DISSIPATION,
+    drag_weighted_face_pressure, face_flux_rate, inlet_face_pressure, inlet_mass_flux, top_face_pressure, PrimView,
+    RhsInput, MOMENTUM_DISSIPATION, PRESSURE_DISSIPATION,
 };
 use super::smart::smart_face;
 
@@ -83,23 +84,31 @@ fn gradients_body(
     let a2 = par.sound_speed * par.sound_speed;
     let (ux, uy, uz, p) = (layer(pr.ux, per, k), layer(pr.uy, per, k), layer(pr.uz, per, k), layer(pr.p, per, k));
     let (div, gx, gy, gz) = (&mut div[..per], &mut gx[..per], &mut gy[..per], &mut gz[..per]);
+    // β/ε² per cell and ε per cell of this layer (`drag_weighted_face_pressure`).
+    let bz = |k: usize, c: usize| pr.beta[k * per + c] / (inp.eps[k * per + c] * inp.eps[k * per + c]);
+    let (eps, eps_b, eps_a) =
+        (layer(inp.eps, per, k), layer(inp.eps, per, k.max(1) - 1), layer(inp.eps, per, (k + 1).min(nz - 1)));
     div.fill(0.0);
     gx.fill(0.0);
     gy.fill(0.0);
     for f in &geo.faces {
         let (a, b) = in_layer(f, per);
-        let flux = 0.5 * ((ux[a] + ux[b]) * f.sx + (uy[a] + uy[b]) * f.sy);
+        let (wx, wy) = (0.5 * (ux[a] + ux[b]), 0.5 * (uy[a] + uy[b]));
+        let flux = wx * f.sx + wy * f.sy;
         div[a] += flux;
         div[b] -= flux;
-        // (p_f − p_c)·S_out is ½(p_b − p_a)·S for both cells.
+        // (p_f − p_c)·S_out with p_f = ½(p_a + p_b) + w: ½(p_b − p_a) + w for a, ½(p_b − p_a) − w for b.
         let dp = 0.5 * (p[b] - p[a]);
-        gx[a] += dp * f.sx;
-        gy[a] += dp * f.sy;
-        gx[b] += dp * f.sx;
-        gy[b] += dp * f.sy;
+        let j = 0.5 * ((eps[a] * ux[a] + eps[b] * ux[b]) * f.dx + (eps[a] * uy[a] + eps[b] * uy[b]) * f.dy);
+        let w = drag_weighted_face_pressure(bz(k, a), bz(k, b), j);
+        gx[a] += (dp + w) * f.sx;
+        gy[a] += (dp + w) * f.sy;
+        gx[b] += (dp - w) * f.sx;
+        gy[b] += (dp - w) * f.sy;
     }
     let (w_in, _) = inp.inlet();
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
+    let jz = |lo: f64, hi: f64| 0.5 * (lo + hi) * inp.dz;
     let below = (k > 0).then(|| (layer(pr.uz, per, k - 1), layer(pr.p, per, k - 1)));
     let above = (k + 1 < nz).then(|| (layer(pr.uz, per, k + 1), layer(pr.p, per, k + 1)));
     // Face values (w, p) below and above each cell.
@@ -121,14 +130,28 @@ fn gradients_body(
         (Some((uzb, pb)), Some((uza, pa))) => {
             // Interior layers: the common case, one vectorisable loop.
             for c in 0..per {
-                let (w_bot, p_bot) = (0.5 * (uzb[c] + uz[c]), 0.5 * (pb[c] + p[c]));
-                let (w_top, p_top) = (0.5 * (uz[c] + uza[c]), 0.5 * (p[c] + pa[c]));
+                let (w_bot, w_top) = (0.5 * (uzb[c] + uz[c]), 0.5 * (uz[c] + uza[c]));
+                let (j_bot, j_top) = (jz(eps_b[c] * uzb[c], eps[c] * uz[c]), jz(eps[c] * uz[c], eps_a[c] * uza[c]));
+                let p_bot = 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz(k - 1, c), bz(k, c), j_bot);
+                let p_top = 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz(k, c), bz(k + 1, c), j_top);
                 div[c] = (div[c] + (w_top - w_bot) * az) * inv_v;
                 gz[c] = (p_top - p_bot) * az * inv_v;
             }
         }
-        (Some((uzb, pb)), None) => close(&|c| (0.5 * (uzb[c] + uz[c]), 0.5 * (pb[c] + p[c])), &top, div, gz),
-        (None, Some((uza, pa))) => close(&inlet, &|c| (0.5 * (uz[c] + uza[c]), 0.5 * (p[c] + pa[c])), div, gz),
+        (Some((uzb, pb)), None) => {
+            let bot = |c: usize| {
+                let j = jz(eps_b[c] * uzb[c], eps[c] * uz[c]);
+                (0.5 * (uzb[c] + uz[c]), 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz(k - 1, c), bz(k, c), j))
+            };
+            close(&bot, &top, div, gz)
+        }
+        (None, Some((uza, pa))) => {
+            let up = |c: usize| {
+                let j = jz(eps[c] * uz[c], eps_a[c] * uza[c]);
+                (0.5 * (uz[c] + uza[c]), 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz(k, c), bz(k + 1, c), j))
+            };
+            close(&inlet, &up, div, gz)
+        }
         (None, None) => close(&inlet, &top, div, gz),
     }
     for c in 0..per {
@@ -153,6 +176,18 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)];
     let (vx, vy, vz) = (four(pr.ux), four(pr.uy), four(pr.uz));
     let ff = &inp.face_flux[lo * per..(lo + 1) * per];
+    // ρεu_z of the four layers for the momentum dissipation; beyond the ends the linear ghosts
+    // 2m_in − m_0 (inlet flux ρ_f U) and 2m_top − m_below.
+    let mz = |k: usize, c: usize| q[k * per + c][3];
+    let ghost_below = |c: usize| {
+        if k >= 1 {
+            mz(k - 1, c)
+        } else {
+            2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - mz(0, c)
+        }
+    };
+    let ghost_above = |c: usize| if k + 2 < nz { mz(k + 2, c) } else { 2.0 * mz(k + 1, c) - mz(k, c) };
+    let km = MOMENTUM_DISSIPATION * par.sound_speed;
     let (out, out_fz) = (&mut out[..per], &mut out_fz[..per]);
     let (az, a, dz) = (geo.area_z, par.sound_speed, inp.dz);
     let kd = PRESSURE_DISSIPATION / par.sound_speed;
@@ -173,11 +208,13 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
         let up = mflux >= 0.0;
         let (fx, fy, fz) = (upwind_face(up, &vx, c), upwind_face(up, &vy, c), upwind_face(up, &vz, c));
         let lam = lam_coef * 0.5 * (d_lo[c] + d_hi[c]) * az;
+        // Momentum mismatch (m_hi − m_lo) − ½(∇m_lo + ∇m_hi)·dz = −¼ × the third difference.
+        let mis_m = -0.25 * (ghost_above(c) - 3.0 * q_hi[c][3] + 3.0 * q_lo[c][3] - ghost_below(c));
         out[c] = [
             mflux,
             mflux * fx,
             mflux * fy,
-            mflux * fz,
+            mflux * fz - km * az * mis_m,
             m * (vx[2][c] - vx[1][c]),
             m * (vy[2][c] - vy[1][c]),
             m * (vz[2][c] - vz[1][c]) + lam,

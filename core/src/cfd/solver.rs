@@ -6,7 +6,9 @@ use super::boundary::{outlet_layer, OutletGeometry};
 use super::geometry::FaceGeometry;
 use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet};
-use super::rhs::{inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives, RhsInput};
+use super::rhs::{
+    drag_weighted_face_pressure, inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives, RhsInput,
+};
 use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
 use super::stability::cell_stable_dt;
 use super::team_step::{fits, team_step, StepInput, StepState};
@@ -285,6 +287,26 @@ impl GasSolver {
         self.st.q.iter().map(|s| s[0]).sum::<f64>() * self.geo.volume
     }
 
+    /// β/ε² of a cell, β = |I|/|u| as rhs_layers.rs `primitives_body` has it.
+    fn drag_over_eps2(&self, cell: usize) -> f64 {
+        let (f, s, e) = (self.st.force[cell], self.st.q[cell], self.st.eps[cell]);
+        let fm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+        if fm > 0.0 {
+            let inv = 1.0 / s[0];
+            let (x, y, z) = (s[1] * inv, s[2] * inv, s[3] * inv);
+            fm / (x * x + y * y + z * z).sqrt().max(1e-6) / (e * e)
+        } else {
+            0.0
+        }
+    }
+
+    /// Superficial velocity εu of a cell, Cartesian.
+    fn superficial_xyz(&self, cell: usize) -> [f64; 3] {
+        let (s, e) = (self.st.q[cell], self.st.eps[cell]);
+        let f = e / s[0];
+        [s[1] * f, s[2] * f, s[3] * f]
+    }
+
     /// ∇p at the cell centre as (∂p/∂r, (1/r)∂p/∂θ, ∂p/∂z): the Green–Gauss gradient of the
     /// momentum equation (rhs.rs `gradients_layer`: wall faces p_c, the ends as documented there).
     pub fn pressure_gradient_cyl(&self, cell: usize) -> [f64; 3] {
@@ -292,21 +314,27 @@ impl GasSolver {
         let (c, k) = (cell % per, cell / per);
         let base = k * per;
         let pc = self.pressure_at(cell);
+        let (bc, jc) = (self.drag_over_eps2(cell), self.superficial_xyz(cell));
         let (mut gx, mut gy) = (0.0, 0.0);
         for n in self.geo.neighbours(c) {
-            let dp = 0.5 * (self.pressure_at(base + n.c as usize) - pc);
+            let nb = base + n.c as usize;
+            let jn = self.superficial_xyz(nb);
+            let jd = 0.5 * ((jc[0] + jn[0]) * n.dx + (jc[1] + jn[1]) * n.dy);
+            let dp = 0.5 * (self.pressure_at(nb) - pc) + drag_weighted_face_pressure(bc, self.drag_over_eps2(nb), jd);
             gx += dp * n.sx;
             gy += dp * n.sy;
         }
-        let (nz, par) = (self.grid.nz, &self.st.params);
+        let (nz, par, dz) = (self.grid.nz, &self.st.params, self.grid.dz);
         let a2 = par.sound_speed * par.sound_speed;
         let p_bot = if k == 0 {
-            inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, self.grid.dz, a2)
+            inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, dz, a2)
         } else {
-            0.5 * (pc + self.pressure_at(cell - per))
+            let (b, jd) = (cell - per, 0.5 * (self.superficial_xyz(cell - per)[2] + jc[2]) * dz);
+            0.5 * (pc + self.pressure_at(b)) + drag_weighted_face_pressure(self.drag_over_eps2(b), bc, jd)
         };
         let p_top = if k + 1 < nz {
-            0.5 * (pc + self.pressure_at(cell + per))
+            let (a, jd) = (cell + per, 0.5 * (jc[2] + self.superficial_xyz(cell + per)[2]) * dz);
+            0.5 * (pc + self.pressure_at(a)) + drag_weighted_face_pressure(bc, self.drag_over_eps2(a), jd)
         } else {
             let p_below = if k > 0 { self.pressure_at(cell - per) } else { pc };
             top_face_pressure(par.outlet, pc, p_below, par.gravity, self.grid.dz, a2)

@@ -2,6 +2,7 @@
 
 mod acoustics;
 mod conservation;
+mod freeboard;
 mod hydrostatic;
 mod layer_pressure;
 mod mass_budget;
