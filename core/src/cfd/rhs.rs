@@ -139,6 +139,20 @@ pub const MOMENTUM_DISSIPATION: f64 = 0.1;
 /// most a/(δ√(1 − s₀)) (stability.rs); the steady state does not depend on it.
 pub const FACE_FLUX_RATE: f64 = 0.1;
 
+/// β = |I|/|u|: the drag coefficient when I = −β(u − v) and the particles are slow (a floor of
+/// 1 µm/s on |u|; 0 where there is no force). Written so that a loop over cells vectorises.
+#[inline(always)]
+pub fn drag_coefficient(f: [f64; 3], u: (f64, f64, f64)) -> f64 {
+    let fm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
+    let um = (u.0 * u.0 + u.1 * u.1 + u.2 * u.2).sqrt();
+    let b = fm / um.max(1e-6);
+    if fm > 0.0 {
+        b
+    } else {
+        0.0
+    }
+}
+
 /// Drag-weighted part of a face pressure, p_f = ½(p_a + p_b) + w (body-force weighting, as
 /// Mencinger & Žun 2007 for a discontinuous body force on a collocated grid): w = ¼(G_a − G_b)·d,
 /// G = −β j_f/ε² each cell's drag-balance gradient −βu/ε at the face's superficial velocity

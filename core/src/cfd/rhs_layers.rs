@@ -10,8 +10,8 @@
 use super::geometry::HFace;
 use super::params::Outlet;
 use super::rhs::{
-    drag_weighted_face_pressure, face_flux_rate, inlet_face_pressure, inlet_mass_flux, top_face_pressure, PrimView,
-    RhsInput, MOMENTUM_DISSIPATION, PRESSURE_DISSIPATION,
+    drag_coefficient, drag_weighted_face_pressure, face_flux_rate, inlet_face_pressure, inlet_mass_flux,
+    top_face_pressure, PrimView, RhsInput, MOMENTUM_DISSIPATION, PRESSURE_DISSIPATION,
 };
 use super::smart::smart_face;
 
@@ -58,13 +58,8 @@ fn primitives_body(
         (ux[c], uy[c], uz[c]) = (x, y, z);
         // Isothermal gas p = ρa², ρ = (ρε)/ε (PHYSICS.md 8).
         p[c] = a2 * s[0] / eps[c];
-        // β = |I|/|u|: the drag coefficient when I = −β(u − v) and the particles are slow; only
-        // the relaxation of the face correction uses it (a floor of 1 µm/s on |u|).
-        let f = force[c];
-        let fm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-        let um = (x * x + y * y + z * z).sqrt();
-        let b = fm / um.max(1e-6);
-        beta[c] = if fm > 0.0 { b } else { 0.0 };
+        // β for the face correction's relaxation and the drag-weighted face pressures.
+        beta[c] = drag_coefficient(force[c], (x, y, z));
     }
 }
 

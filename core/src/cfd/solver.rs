@@ -7,7 +7,8 @@ use super::geometry::FaceGeometry;
 use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet};
 use super::rhs::{
-    drag_weighted_face_pressure, inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives, RhsInput,
+    drag_coefficient, drag_weighted_face_pressure, inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives,
+    RhsInput,
 };
 use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
 use super::stability::cell_stable_dt;
@@ -287,17 +288,11 @@ impl GasSolver {
         self.st.q.iter().map(|s| s[0]).sum::<f64>() * self.geo.volume
     }
 
-    /// β/ε² of a cell, β = |I|/|u| as rhs_layers.rs `primitives_body` has it.
+    /// β/ε² of a cell, with β as the primitives have it (rhs.rs `drag_coefficient`).
     fn drag_over_eps2(&self, cell: usize) -> f64 {
-        let (f, s, e) = (self.st.force[cell], self.st.q[cell], self.st.eps[cell]);
-        let fm = (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt();
-        if fm > 0.0 {
-            let inv = 1.0 / s[0];
-            let (x, y, z) = (s[1] * inv, s[2] * inv, s[3] * inv);
-            fm / (x * x + y * y + z * z).sqrt().max(1e-6) / (e * e)
-        } else {
-            0.0
-        }
+        let (s, e) = (self.st.q[cell], self.st.eps[cell]);
+        let inv = 1.0 / s[0];
+        drag_coefficient(self.st.force[cell], (s[1] * inv, s[2] * inv, s[3] * inv)) / (e * e)
     }
 
     /// Superficial velocity εu of a cell, Cartesian.

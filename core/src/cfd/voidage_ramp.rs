@@ -19,15 +19,17 @@ pub struct VoidageRamp {
 
 impl VoidageRamp {
     /// The ramp from the previous ramp's end (or, for the first, `current`) to `eps`, from
-    /// `start` over `span` seconds.
+    /// `start` over `span` seconds; it takes over the previous ramp's storage.
     pub fn next(previous: Option<VoidageRamp>, current: &[f64], eps: &[f64], start: f64, span: f64) -> VoidageRamp {
         assert!(span > 0.0, "a ramp needs a positive interval");
         assert_eq!(current.len(), eps.len(), "one voidage per cell");
-        let from = match previous {
-            Some(p) if p.to.len() == eps.len() => p.to,
-            _ => current.to_vec(),
+        let (from, mut to) = match previous {
+            Some(p) if p.to.len() == eps.len() => (p.to, p.from),
+            _ => (current.to_vec(), Vec::new()),
         };
-        VoidageRamp { from, to: eps.to_vec(), start, span }
+        to.clear();
+        to.extend_from_slice(eps);
+        VoidageRamp { from, to, start, span }
     }
 
     /// The particles' field the ramp ends at (of the last coupling).
