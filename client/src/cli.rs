@@ -169,6 +169,14 @@ fn print_analysis(a: &serde_json::Value) {
         num(&rise["lower_m"]),
         num(&rise["upper_m"])
     );
+    let e = &a["eruptions"];
+    println!(
+        "eruptions {} per second at {} m, {} ΔP cycles per eruption, ΔP swing {} Pa around them",
+        num(&e["link"]["eruptions_per_s"]),
+        num(&e["height_m"]),
+        num(&e["dp_frequency_per_eruption"]),
+        num(&e["link"]["swing_pa"])
+    );
 }
 
 async fn dispatch(cli: Cli) -> i32 {

@@ -115,8 +115,13 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
 }
 
 /// The figures of `GET /v1/jobs/{id}/analysis/{figure}`.
-const ANALYSIS_FIGURES: [&str; 4] =
-    ["pressure_spectrum.png", "rise_correlation.png", "particle_velocity_map.png", "voidage_map.png"];
+const ANALYSIS_FIGURES: [&str; 5] = [
+    "pressure_spectrum.png",
+    "rise_correlation.png",
+    "eruption_link.png",
+    "particle_velocity_map.png",
+    "voidage_map.png",
+];
 
 /// The job's analysis into `out`: `analysis.json` and the figures it has samples for (a figure
 /// without enough samples, or a job without a checkpoint yet, is skipped).

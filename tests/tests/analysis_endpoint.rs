@@ -61,6 +61,15 @@ async fn analysis_of_a_finished_job_matches_its_pressure_series_and_draws_its_fi
         let p = Picture::decode(&r.bytes().await.unwrap());
         assert!(p.colours() > 20 && p.dark_in_rows(0..40) > 100, "{figure}: a titled figure");
     }
+    // The eruption figure exists exactly when the analysis found eruptions (a problem otherwise).
+    let r = http.get(format!("{url}/analysis/eruption_link.png")).send().await.unwrap();
+    if a["eruptions"].is_null() {
+        assert_eq!(r.status(), 404);
+        assert_eq!(r.headers()["content-type"], "application/problem+json");
+    } else {
+        assert_eq!(r.status(), 200, "{}", a["eruptions"]);
+        assert_eq!(r.headers()["content-type"], "image/png");
+    }
     let r = http.get(format!("{url}/analysis/bogus.png")).send().await.unwrap();
     assert_eq!(r.status(), 404);
     assert_eq!(r.headers()["content-type"], "application/problem+json");

@@ -246,7 +246,7 @@ fn layer_height_point(reference: &Case, r: Stats) {
 
 /// `-- tradeoff layer`: the reference window and the layer-height point alone.
 /// The gas's voidage interpolated between couplings (`coupling.gas_voidage`) at long intervals,
-/// beside the held voidage at the longest, against the paper's every-step reference.
+/// beside the held voidage, against the paper's every-step reference and its noise floor.
 fn gas_voidage_front() {
     let reference = bed(1);
     let (ref_snaps, ref_cost) = window(&reference, "tradeoff-seed1", 1);
@@ -256,6 +256,12 @@ fn gas_voidage_front() {
         "{}",
         json!({"bench": "tradeoff_point", "knob": "coupling_interval", "setting": 1, "wall_s_per_sim_s": ref_cost,
         "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
+    );
+    let (floor_snaps, _) = window(&bed(2), "tradeoff-seed2", 1);
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
+        "errors": errors(&stats(&floor_snaps, &grid), &r)})
     );
     let (held, interpolated) = (GasVoidage::Held, GasVoidage::Interpolated);
     for (how, interval) in

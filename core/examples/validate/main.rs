@@ -9,6 +9,7 @@ mod fig3;
 mod fluidized;
 mod packed_bed;
 mod plots;
+mod pressure_oscillation;
 mod slug_rise;
 mod table3;
 mod umf;
@@ -31,10 +32,11 @@ fn main() {
         "bubbling-stats" => report(bubbling_stats::run()),
         "analysis-signals" => report(analysis_signals::run()),
         "slug-rise" => report(slug_rise::run()),
+        "pressure-oscillation" => report(pressure_oscillation::run()),
         // Any case file, with the per-stage wall times: `-- case cases/quickstart.json`
         "case" => report(common::timed_case(&std::env::args().nth(2).expect("case file"))),
         other => {
-            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, umf-paper-cells, fig3, bubbling, bubbling-stats, slug-rise or analysis-signals");
+            eprintln!("unknown validation {other:?}; choose table3, packed-bed, fluidized, umf, umf-paper-cells, fig3, bubbling, bubbling-stats, slug-rise, pressure-oscillation or analysis-signals");
             std::process::exit(2);
         }
     }

@@ -9,7 +9,8 @@
 //! (the paper's point that U − U_mf belongs in the formula: near 1).
 //!
 //! Each velocity is a long run (≈ 2.6 simulated s): it keeps a checkpoint in target/validate-cache
-//! every 0.05 s and resumes there; a finished run is kept there and not run again. Voidage slices
+//! every 0.05 s and resumes there; a finished run keeps its last checkpoint there and is not run
+//! again (its analysis is read from that checkpoint by the current build). Voidage slices
 //! of the last snapshots go to docs/img/slug_rise_U*.png, to tell round-nosed slugs from
 //! wall-spanning plugs.
 
@@ -29,9 +30,15 @@ const END_S: f64 = 2.6;
 const SETTLED_M: f64 = 0.09;
 const COLUMN_M: f64 = 0.22;
 
-/// What a finished run keeps.
+/// What a finished run keeps beside its last checkpoint.
 #[derive(Serialize, Deserialize)]
 struct Kept {
+    particles: usize,
+    wall_s: f64,
+}
+
+/// A finished run: what it kept and the analysis of its last checkpoint.
+struct Finished {
     particles: usize,
     wall_s: f64,
     analysis: AnalysisReport,
@@ -65,16 +72,30 @@ pub fn stewart_davidson(u: f64, umf: f64, d: f64) -> f64 {
     (u - umf) + 0.35 * (9.81 * d).sqrt()
 }
 
+/// Where the run at `u` is kept (`.ckpt`: its checkpoint, the last one once it has finished).
+fn cache_path(u: f64) -> String {
+    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case(u)).expect("case to JSON"));
+    format!("target/validate-cache/slug-rise-U{u}-{key:016x}.bin")
+}
+
+/// The analysis of the finished run at `u`, if it has finished (never starts it).
+pub fn finished_at(u: f64) -> Option<AnalysisReport> {
+    let cache = cache_path(u);
+    bincode::deserialize::<Kept>(&std::fs::read(&cache).ok()?).ok()?;
+    let bytes = std::fs::read(format!("{cache}.ckpt")).ok()?;
+    Simulation::analysis_of_checkpoint(&bytes, None).ok().map(|(_, _, a)| a)
+}
+
 /// The run at `u`, from the cache, resumed from its checkpoint or run now.
-fn run_at(u: f64) -> Kept {
+fn run_at(u: f64) -> Finished {
     let case = case(u);
-    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
-    let cache = format!("target/validate-cache/slug-rise-U{u}-{key:016x}.bin");
-    if let Some(k) = std::fs::read(&cache).ok().and_then(|b| bincode::deserialize::<Kept>(&b).ok()) {
-        eprintln!("[slug-rise U={u}] using the run kept in {cache} (delete it to run again)");
-        return k;
-    }
+    let cache = cache_path(u);
     let ckpt = format!("{cache}.ckpt");
+    let kept = std::fs::read(&cache).ok().and_then(|b| bincode::deserialize::<Kept>(&b).ok());
+    if let (Some(k), Some(analysis)) = (kept, finished_at(u)) {
+        eprintln!("[slug-rise U={u}] using the run kept in {cache} and {ckpt} (delete them to run again)");
+        return Finished { particles: k.particles, wall_s: k.wall_s, analysis };
+    }
     // The wall time so far rides in the checkpoint's file name's sibling.
     let wall_file = format!("{cache}.wall");
     let resumed = std::fs::read(&ckpt).ok().and_then(|b| Simulation::restore(&b).ok());
@@ -109,17 +130,12 @@ fn run_at(u: f64) -> Kept {
             write_atomically(&wall_file, wall.to_string().as_bytes());
         }
     }
-    let kept = Kept {
-        particles: sim.dem().len(),
-        wall_s: wall_before + t0.elapsed().as_secs_f64(),
-        analysis: sim.analysis_report(),
-    };
+    let kept = Kept { particles: sim.dem().len(), wall_s: wall_before + t0.elapsed().as_secs_f64() };
+    // The last checkpoint stays: the finished run's analysis is read from it.
+    write_atomically(&ckpt, &sim.checkpoint());
     write_atomically(&cache, &bincode::serialize(&kept).expect("kept run"));
-    // The checkpoint goes only once the kept run reads back.
-    let back = std::fs::read(&cache).ok().and_then(|b| bincode::deserialize::<Kept>(&b).ok());
-    assert!(back.is_some(), "the run kept in {cache} does not read back; its checkpoint {ckpt} stays");
-    let _ = (std::fs::remove_file(&ckpt), std::fs::remove_file(&wall_file));
-    kept
+    let _ = std::fs::remove_file(&wall_file);
+    Finished { particles: kept.particles, wall_s: kept.wall_s, analysis: sim.analysis_report() }
 }
 
 /// Least-squares slope of y on x.
@@ -148,6 +164,8 @@ pub fn run() -> serde_json::Value {
                 "stewart_davidson_m_s": want, "rel_err": err, "peak": r.map(|r| r.peak), "delay_s": r.map(|r| r.delay_s),
                 "heights_m": rise.map(|r| [r.lower_m, r.upper_m]), "bed_height_m": k.analysis.bed_height_m,
                 "dp_dominant_hz": k.analysis.pressure_drop.as_ref().and_then(|p| p.dominant_frequency_hz),
+                "eruptions_per_s": k.analysis.eruptions.as_ref().map(|e| e.link.eruptions_per_s),
+                "dp_cycles_per_eruption": k.analysis.eruptions.as_ref().and_then(|e| e.dp_frequency_per_eruption),
                 "window_s": [k.analysis.from_s, k.analysis.to_s], "wall_s": k.wall_s})
         );
         if got.is_finite() {

@@ -10,6 +10,7 @@
 //!   bubble counts and correlations;
 //! - [`bubble_count`]: bubbles passing a height per second (threshold crossings with hysteresis);
 //! - [`bubble_fraction`]: bubble volume fraction by height;
+//! - [`eruptions`]: bubble eruptions at the bed surface against ΔP (paper Fig. 9);
 //! - [`particle_average`]: particle-based time averages per cell (Boyce et al. 2013);
 //! - [`field_average`]: time averages of the cell fields (voidage, gas velocity);
 //! - [`profiles`]: radial profiles at chosen heights and azimuthal-mean maps on the axial plane;
@@ -22,6 +23,7 @@
 pub mod bubble_count;
 pub mod bubble_fraction;
 pub mod correlation;
+pub mod eruptions;
 pub mod field_average;
 pub mod layer_series;
 pub mod layers;
@@ -34,6 +36,7 @@ pub mod stats;
 pub use bubble_count::{count_bubbles, BubbleCount};
 pub use bubble_fraction::{BubbleFraction, ByHeight};
 pub use correlation::{cross_correlation, rise_velocity, RiseVelocity};
+pub use eruptions::{eruption_link, EruptionLink};
 pub use field_average::{FieldAverage, FieldMeans};
 pub use layer_series::LayerSeries;
 pub use layers::{bed_pressure_drop, layer_means};

@@ -13,9 +13,9 @@
 //! rise velocity searches delays up to half the record.
 
 use crate::analysis::{
-    axial_map, bed_pressure_drop, count_bubbles, dominant_frequency, layer_means, radial_profile, rise_velocity,
-    signal_stats, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, FieldAverage, LayerSeries, ParticleAverage,
-    RadialProfile, RiseVelocity, Spectrum,
+    axial_map, bed_pressure_drop, count_bubbles, dominant_frequency, eruption_link, layer_means, radial_profile,
+    rise_velocity, signal_stats, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, EruptionLink, FieldAverage,
+    LayerSeries, ParticleAverage, RadialProfile, RiseVelocity, Spectrum,
 };
 use crate::case::{AnalysisSpec, Case};
 use crate::grid::CylGrid;
@@ -23,6 +23,9 @@ use serde::{Deserialize, Serialize};
 
 /// Cell voidage below which a layer counts as bed, for the bed height.
 const BED_VOIDAGE: f64 = 0.8;
+
+/// Eruptions are bubble fronts at this fraction of the bed height (just below the surface).
+const ERUPTION_HEIGHT: f64 = 0.9;
 
 /// The accumulated samples of one run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -67,6 +70,8 @@ pub struct AnalysisReport {
     pub bubbles: Option<Bubbles>,
     pub bubble_fraction: ByHeight,
     pub rise_velocity: Option<Rise>,
+    /// Bubble eruptions at the bed surface against ΔP (paper Fig. 9).
+    pub eruptions: Option<Eruptions>,
     /// Particle-based ⟨v_z⟩ (m/s) and the time-averaged voidage on the axial plane (r, z).
     pub particle_velocity_map: AxialMap,
     pub voidage_map: AxialMap,
@@ -88,6 +93,19 @@ pub struct Bubbles {
     pub rise: f64,
     pub fall: f64,
     pub count: BubbleCount,
+}
+
+/// Eruptions where the cross-section voidage at `height_m` (0.9 of the bed height) rises through
+/// its mean + one standard deviation after it was below its mean, and the triggered average of ΔP
+/// over one mean eruption period (at most 0.5 s) each side.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Eruptions {
+    pub height_m: f64,
+    pub rise: f64,
+    pub fall: f64,
+    pub link: EruptionLink,
+    /// ΔP's dominant frequency over the eruption rate (1: one ΔP cycle per eruption).
+    pub dp_frequency_per_eruption: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -184,6 +202,8 @@ impl RunAnalysis {
             let half = 0.5 * a.len() as f64 * dt;
             Rise { lower_m: lo, upper_m: hi, voidage: (dz > 0.0).then(|| rise_velocity(a, b, dt, dz, half)).flatten() }
         });
+        let dp_hz = pressure_drop.as_ref().and_then(|p| p.dominant_frequency_hz);
+        let eruptions = bed_height_m.and_then(|h| self.eruptions_at(ERUPTION_HEIGHT * h, dt, skip, dp, dp_hz));
         let heights = if self.spec.profile_heights_m.is_empty() {
             bed_height_m.map(|h| vec![0.5 * h]).unwrap_or_default()
         } else {
@@ -209,6 +229,7 @@ impl RunAnalysis {
             bubbles,
             bubble_fraction: self.bubbles.finish(),
             rise_velocity,
+            eruptions,
             particle_velocity_map,
             voidage_map,
             radial_profiles,
@@ -228,6 +249,20 @@ impl RunAnalysis {
         let st = signal_stats(&x)?;
         let (rise, fall) = (st.mean + st.std, st.mean);
         (rise > fall).then(|| Bubbles { height_m: z, rise, fall, count: count_bubbles(&x, dt, rise, fall) })
+    }
+
+    fn eruptions_at(&self, z: f64, dt: f64, skip: usize, dp: &[f64], dp_hz: Option<f64>) -> Option<Eruptions> {
+        let x = self.voidage_layers.at_height(z).split_off(skip);
+        let st = signal_stats(&x)?;
+        let (rise, fall) = (st.mean + st.std, st.mean);
+        if rise <= fall {
+            return None;
+        }
+        let rate = count_bubbles(&x, dt, rise, fall).per_second;
+        let half = if rate > 0.0 { (1.0 / rate).min(0.5) } else { 0.5 };
+        let link = eruption_link(dp, &x, dt, rise, fall, half)?;
+        let per = dp_hz.filter(|_| link.eruptions_per_s > 0.0).map(|f| f / link.eruptions_per_s);
+        Some(Eruptions { height_m: z, rise, fall, link, dp_frequency_per_eruption: per })
     }
 }
 
@@ -378,5 +413,57 @@ mod tests {
         // The profile at half the bed height, 6 mm, is layer 3's.
         assert_eq!(r.radial_profiles.len(), 1);
         assert!((r.radial_profiles[0].height_m - 0.006).abs() < 1e-12);
+    }
+
+    /// Eruptions: a bed of ε = 0.4 below 12 mm whose top layers (the eruption height, 0.9 × 12 mm,
+    /// among them) open to ε = 0.9 for 30 ms every 0.1 s from t = 0.1 s on, and a bed drop of
+    /// 100 + 10 sin(2π·10 t) Pa. Ten eruptions per second, each at a ΔP phase of 0, so the
+    /// triggered average is 10 sin(2π·10 τ): swing 20 Pa, and one ΔP cycle per eruption.
+    #[test]
+    fn eruptions_at_the_surface_are_counted_and_linked_to_the_pressure_drop() {
+        let case: Case = serde_json::from_str(
+            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
+               "dem":{"time_step_s":1e-3},"analysis":{"from_s":0.05,"sample_interval_s":0.002}}"#,
+        )
+        .unwrap();
+        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
+        let mut a = RunAnalysis::new(&case, &grid);
+        let (n, per) = (grid.num_cells(), grid.cells_per_layer());
+        let none: Vec<[f64; 3]> = vec![];
+        for step in 0..=2050u64 {
+            let t = step as f64 * 1e-3;
+            if !a.due(step, t) {
+                continue;
+            }
+            let open = (t * 10.0 + 1e-9).fract() < 0.3;
+            let eps: Vec<f64> = (0..n)
+                .map(|c| match grid.centre_xyz(c)[2] {
+                    z if z > 0.012 => 1.0,
+                    z if z > 0.008 && open => 0.9,
+                    _ => 0.4,
+                })
+                .collect();
+            let dp = 100.0 + 10.0 * (2.0 * PI * 10.0 * t).sin();
+            let slope = dp / (grid.nz as f64 - 1.0);
+            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
+            let s = Sample {
+                time_s: t,
+                voidage: &eps,
+                pressure_pa: Some(&p),
+                gas_velocity: None,
+                positions: &none,
+                velocities: &none,
+            };
+            a.add(&grid, &s);
+        }
+        let r = a.report(&grid);
+        let e = r.eruptions.as_ref().expect("eruptions");
+        assert!((e.height_m - 0.9 * 0.012).abs() < 1e-12, "height {}", e.height_m);
+        // Fronts at 0.1, 0.2, … 2.0 s: 20 in a record of 2.0 s.
+        assert_eq!(e.link.eruptions, 20, "{:?}", e.link.eruptions_s);
+        assert!((e.link.eruptions_per_s - 10.0).abs() < 0.1, "{}", e.link.eruptions_per_s);
+        assert!((e.link.swing_pa - 20.0).abs() < 0.2, "swing {}", e.link.swing_pa);
+        let ratio = e.dp_frequency_per_eruption.expect("ratio");
+        assert!((ratio - 1.0).abs() < 0.05, "ΔP cycles per eruption {ratio}");
     }
 }

@@ -16,8 +16,13 @@ use fluidbed_core::sim::{AnalysisReport, Simulation};
 use std::sync::Arc;
 
 /// The figures `GET /v1/jobs/{id}/analysis/{figure}` draws.
-const FIGURES: [&str; 4] =
-    ["pressure_spectrum.png", "rise_correlation.png", "particle_velocity_map.png", "voidage_map.png"];
+const FIGURES: [&str; 5] = [
+    "pressure_spectrum.png",
+    "rise_correlation.png",
+    "eruption_link.png",
+    "particle_velocity_map.png",
+    "voidage_map.png",
+];
 
 /// The report of the job's last checkpoint, or the problem to answer with.
 async fn report(app: &Arc<App>, id: &str, q: &AnalysisQuery) -> Result<(CylGrid, AnalysisReport, String), Response> {
@@ -74,6 +79,7 @@ pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>, Query(q): 
 
 /// One figure of the analysis: `pressure_spectrum.png` (Welch PSD of ΔP),
 /// `rise_correlation.png` (the voidage cross-correlation between the two rise heights),
+/// `eruption_link.png` (ΔP averaged around the bubble eruptions at the bed surface, Fig. 9),
 /// `particle_velocity_map.png` (particle-based ⟨v_z⟩ on the axial plane, as the paper's Fig. 7),
 /// `voidage_map.png` (time-averaged voidage on the axial plane, Fig. 6).
 #[utoipa::path(
@@ -83,7 +89,7 @@ pub async fn get(State(app): State<Arc<App>>, Path(id): Path<String>, Query(q): 
     tag = "results",
     params(
         ("id" = String, Path, description = "The job id"),
-        ("figure" = String, Path, description = "pressure_spectrum.png, rise_correlation.png, particle_velocity_map.png or voidage_map.png"),
+        ("figure" = String, Path, description = "pressure_spectrum.png, rise_correlation.png, eruption_link.png, particle_velocity_map.png or voidage_map.png"),
         AnalysisQuery,
     ),
     responses(
@@ -143,6 +149,22 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
             );
             let labels = plot::TraceLabels { title: &title, x: "delay τ [s]", y: "cross-correlation R(τ) [-]" };
             plot::trace(&lag, &v.correlation, &labels)
+        }
+        "eruption_link.png" => {
+            let Some(e) = r.eruptions.as_ref() else {
+                return too_few("no bubble eruption at the bed surface yet");
+            };
+            let title = format!(
+                "{job_name}: ΔP around {} eruptions at {:.0} mm ({:.2} /s), {series}",
+                e.link.averaged,
+                1e3 * e.height_m,
+                e.link.eruptions_per_s
+            );
+            let labels =
+                plot::TraceLabels {
+                    title: &title, x: "time from eruption τ [s]", y: "ΔP(t_e + τ) − mean ΔP [Pa]"
+                };
+            plot::trace(&e.link.lag_s, &e.link.triggered_dp_pa, &labels)
         }
         "particle_velocity_map.png" => {
             let field = r.particle_velocity_map.cell_field(grid);

@@ -1,0 +1,70 @@
+//! Pressure oscillation and bubble eruptions (issue: science, paper section 3.4 and Fig. 9: "the
+//! period of oscillations in pressure drop matches the period of time taken for a pair of bubbles
+//! to erupt at the top of the bed"). The paper's bed (50 mm, 110 mm settled, ≈ 150k particles for
+//! several seconds) does not fit a session on 2 cores, so this reads beds that do:
+//! - the 44-mm bubbling bed at 0.6 m/s (the run of `bubbling`, 2 simulated s);
+//! - the 22-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
+//!   paper's 0.563 m/s), where their runs have finished (this never starts them).
+//!
+//! Each run's analysis (accumulated while it ran) gives ΔP's dominant frequency, the eruptions at
+//! 0.9 of the bed height per second, their ratio (ΔP cycles per eruption: ½ is the paper's pair)
+//! and ΔP averaged around the eruptions (`analysis::eruption_link`), drawn to
+//! docs/img/pressure_oscillation_*.png. Last line: the slugging beds' ratio against the paper's ½
+//! (the bubbling bed's where no slugging run has finished, with no reference).
+
+use crate::plots::{series_with_level, TraceLabels};
+use fluidbed_core::sim::AnalysisReport;
+use serde_json::{json, Value};
+
+/// ΔP cycles per eruption in the paper's slugging bed: one ΔP period per pair of eruptions.
+const PAPER_CYCLES_PER_ERUPTION: f64 = 0.5;
+
+fn point(label: &str, a: &AnalysisReport, png: &str) -> Value {
+    let dp = a.pressure_drop.as_ref();
+    let e = a.eruptions.as_ref();
+    if let Some(e) = e {
+        let pts: Vec<(f64, f64)> = e.link.lag_s.iter().copied().zip(e.link.triggered_dp_pa.iter().copied()).collect();
+        let title = format!("{label}: ΔP around {} eruptions at {:.0} mm", e.link.averaged, 1e3 * e.height_m);
+        let labels =
+            TraceLabels { title: &title, x: "time from eruption τ [s]", y: "ΔP(t_e + τ) − mean ΔP [Pa]" };
+        series_with_level(&pts, 0.0, &labels, png);
+    }
+    json!({"bed": label, "window_s": [a.series_from_s, a.to_s], "samples": a.series_samples,
+        "dp_mean_pa": dp.map(|p| p.mean_pa), "dp_std_pa": dp.map(|p| p.std_pa),
+        "dp_dominant_hz": dp.and_then(|p| p.dominant_frequency_hz), "bed_height_m": a.bed_height_m,
+        "eruption_height_m": e.map(|e| e.height_m), "eruptions_per_s": e.map(|e| e.link.eruptions_per_s),
+        "dp_cycles_per_eruption": e.and_then(|e| e.dp_frequency_per_eruption),
+        "swing_pa": e.map(|e| e.link.swing_pa), "lag_of_dp_max_s": e.map(|e| e.link.lag_of_max_s),
+        "lag_of_dp_min_s": e.map(|e| e.link.lag_of_min_s)})
+}
+
+pub fn run() -> Value {
+    let r = crate::bubbling::run_to(crate::bubbling::end_s());
+    let a = r.analysis.expect("the bubbling run keeps its last checkpoint (rerun `bubbling` if it predates that)");
+    let bubbling = point("44-mm bed, 30 mm settled, U = 0.6 m/s", &a, "docs/img/pressure_oscillation_44mm.png");
+    println!("{bubbling}");
+    let mut slugging = Vec::new();
+    for u in [0.54, 0.60] {
+        match crate::slug_rise::finished_at(u) {
+            Some(a) => {
+                let p = point(
+                    &format!("22-mm bed, 90 mm settled, U = {u} m/s"),
+                    &a,
+                    &format!("docs/img/pressure_oscillation_22mm_U{u}.png"),
+                );
+                println!("{p}");
+                slugging.push(p);
+            }
+            None => eprintln!("[pressure-oscillation] the slug-rise run at U = {u} m/s has not finished; not read"),
+        }
+    }
+    let ratios: Vec<f64> = slugging.iter().filter_map(|p| p["dp_cycles_per_eruption"].as_f64()).collect();
+    if ratios.is_empty() {
+        json!({"name": "pressure-oscillation", "figure": bubbling["dp_cycles_per_eruption"], "reference": null,
+            "rel_err": null, "bed": bubbling["bed"]})
+    } else {
+        let figure = ratios.iter().sum::<f64>() / ratios.len() as f64;
+        json!({"name": "pressure-oscillation", "figure": figure, "reference": PAPER_CYCLES_PER_ERUPTION,
+            "rel_err": figure / PAPER_CYCLES_PER_ERUPTION - 1.0, "bed": "22-mm slugging beds at 0.54 and 0.60 m/s"})
+    }
+}
