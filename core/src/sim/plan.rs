@@ -81,8 +81,12 @@ impl Plan {
         } else if self.coupling && !self.particles_move {
             out.push("voidage and drag per particle: the frozen bed's voidage is computed once and the exchange per cell (O(cells))".into());
         } else if self.coupling && self.coupling_interval > 1 {
+            let gas = match case.coupling.gas_voidage {
+                crate::case::GasVoidage::Held => "held",
+                crate::case::GasVoidage::Interpolated => "interpolated",
+            };
             out.push(format!(
-                "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), held in between",
+                "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), the drag held in between and the gas's voidage {gas} (coupling.gas_voidage)",
                 self.coupling_interval
             ));
         }
