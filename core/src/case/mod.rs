@@ -73,11 +73,10 @@ pub struct Coupling {
     /// than the cells (docs/VALIDATION.md, "U_mf with the paper's cells and the drag voidage on sub-layers").
     #[serde(default = "d_drag_sublayers")]
     pub drag_voidage_sublayers: u32,
-    /// The gas's voidage between couplings: "interpolated" (the default: from the previous
-    /// coupling's field to the new one over the next interval, one interval behind the particles
-    /// and without steps; cfd/voidage_ramp.rs) or "held" (the paper's: each coupling's field at
-    /// once; the gas mass of each cell is held, so the change shows as a pressure step). Default
-    /// from the run-time/error trade-off (docs/BENCHMARKS.md).
+    /// The gas's voidage between couplings: "held" (the paper's: each coupling's field at once;
+    /// the gas mass of each cell is held, so the change shows as a pressure step) or
+    /// "interpolated" (from the previous coupling's field to the new one over the next interval,
+    /// one interval behind the particles and without steps; cfd/voidage_ramp.rs).
     #[serde(default)]
     pub gas_voidage: GasVoidage,
 }
@@ -86,8 +85,8 @@ pub struct Coupling {
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum GasVoidage {
-    Held,
     #[default]
+    Held,
     Interpolated,
 }
 
@@ -97,7 +96,7 @@ impl Default for Coupling {
             drag_law: Default::default(),
             interval_steps: d_coupling_interval(),
             drag_voidage_sublayers: d_drag_sublayers(),
-            gas_voidage: GasVoidage::default(),
+            gas_voidage: GasVoidage::Held,
         }
     }
 }
@@ -107,7 +106,7 @@ fn d_drag_sublayers() -> u32 {
 }
 
 fn d_coupling_interval() -> u32 {
-    20
+    10
 }
 
 /// The cylindrical column (tube). Its axis is the z axis, the distributor plate is z = 0.
