@@ -18,7 +18,7 @@ pub use job::{CaseProblem, Job, JobLinks, JobList, JobStatus, Severity};
 pub use problem::{FieldError, Problem};
 pub use query::{
     AnalysisQuery, EventsQuery, ListQuery, PageQuery, SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat,
-    SnapshotQuery,
+    SnapshotQuery, ANALYSIS_FIGURES,
 };
 pub use snapshot::{Binary, GridInfo, ParticleState, PressureDropSeries, SnapshotDocument, SnapshotInfo, SnapshotList};
 pub use sweep::{GridAxis, PointSummary, Sweep, SweepList, SweepPoint, SweepRequest};

@@ -131,6 +131,15 @@ pub struct AnalysisQuery {
     pub from: Option<f64>,
 }
 
+/// The figures of `GET /v1/jobs/{id}/analysis/{figure}`, the server's and the client's one list.
+pub const ANALYSIS_FIGURES: [&str; 5] = [
+    "pressure_spectrum.png",
+    "rise_correlation.png",
+    "eruption_link.png",
+    "particle_velocity_map.png",
+    "voidage_map.png",
+];
+
 /// `GET /v1/jobs/{id}/events`.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, IntoParams)]
 #[into_params(parameter_in = Query)]

@@ -172,8 +172,8 @@ fn print_analysis(a: &serde_json::Value) {
     let e = &a["eruptions"];
     println!(
         "eruptions {} per second at {} m, {} ΔP cycles per eruption, ΔP swing {} Pa around them",
-        num(&e["link"]["eruptions_per_s"]),
-        num(&e["height_m"]),
+        num(&e["fronts"]["count"]["per_second"]),
+        num(&e["fronts"]["height_m"]),
         num(&e["dp_frequency_per_eruption"]),
         num(&e["link"]["swing_pa"])
     );

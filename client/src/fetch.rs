@@ -3,7 +3,7 @@
 //! for ParaView, and PNGs of the last voidage slice and of the ΔP (or bed-height) trace.
 
 use crate::api::{Api, ApiError};
-use fluidbed_api::{SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery};
+use fluidbed_api::{SeriesFormat, SeriesQuery, SnapshotField, SnapshotFormat, SnapshotQuery, ANALYSIS_FIGURES};
 use std::path::{Path, PathBuf};
 
 fn snapshot(format: SnapshotFormat, field: Option<SnapshotField>) -> SnapshotQuery {
@@ -113,15 +113,6 @@ pub async fn fetch(api: &Api, id: &str, out: &Path, formats: &Formats) -> Result
     files.extend(fetch_analysis(api, id, out, None).await?);
     Ok(files)
 }
-
-/// The figures of `GET /v1/jobs/{id}/analysis/{figure}`.
-const ANALYSIS_FIGURES: [&str; 5] = [
-    "pressure_spectrum.png",
-    "rise_correlation.png",
-    "eruption_link.png",
-    "particle_velocity_map.png",
-    "voidage_map.png",
-];
 
 /// The job's analysis into `out`: `analysis.json` and the figures it has samples for (a figure
 /// without enough samples, or a job without a checkpoint yet, is skipped).

@@ -265,18 +265,19 @@ pub fn run() -> serde_json::Value {
     for p in dp.iter_mut() {
         *p += 0.3 * noise.gauss();
     }
-    let link = eruption_link(&dp, &surface, dt, 0.8, 0.5, 0.1).expect("eruptions");
+    let fronts = count_bubbles(&surface, dt, 0.8, 0.5);
+    let link = eruption_link(&dp, &fronts.fronts_s, dt, 0.1).expect("eruptions");
     let rate_in = starts.len() as f64 / secs;
     eprintln!(
         "eruptions: {} put in ({rate_in:.3} /s), found {} ({:.3} /s); ΔP peak {:.1} ms after them (put in {:.0} ms), swing {:.3} Pa (put in {bump})",
         starts.len(),
-        link.eruptions,
-        link.eruptions_per_s,
+        fronts.bubbles,
+        fronts.per_second,
         link.lag_of_max_s * 1e3,
         lag * 1e3,
         link.swing_pa
     );
-    out["eruption_rate_rel_err"] = json!(rel(link.eruptions_per_s, rate_in));
+    out["eruption_rate_rel_err"] = json!(rel(fronts.per_second, rate_in));
     out["eruption_dp_lag_rel_err"] = json!(rel(link.lag_of_max_s, lag));
     out["eruption_dp_swing_rel_err"] = json!(rel(link.swing_pa, bump));
     out

@@ -24,7 +24,7 @@ fn point(label: &str, a: &AnalysisReport, png: &str) -> Value {
     let e = a.eruptions.as_ref();
     if let Some(e) = e {
         let pts: Vec<(f64, f64)> = e.link.lag_s.iter().copied().zip(e.link.triggered_dp_pa.iter().copied()).collect();
-        let title = format!("{label}: ΔP around {} eruptions at {:.0} mm", e.link.averaged, 1e3 * e.height_m);
+        let title = format!("{label}: ΔP around {} eruptions at {:.0} mm", e.link.averaged, 1e3 * e.fronts.height_m);
         let labels =
             TraceLabels { title: &title, x: "time from eruption τ [s]", y: "ΔP(t_e + τ) − mean ΔP [Pa]" };
         series_with_level(&pts, 0.0, &labels, png);
@@ -32,7 +32,7 @@ fn point(label: &str, a: &AnalysisReport, png: &str) -> Value {
     json!({"bed": label, "window_s": [a.series_from_s, a.to_s], "samples": a.series_samples,
         "dp_mean_pa": dp.map(|p| p.mean_pa), "dp_std_pa": dp.map(|p| p.std_pa),
         "dp_dominant_hz": dp.and_then(|p| p.dominant_frequency_hz), "bed_height_m": a.bed_height_m,
-        "eruption_height_m": e.map(|e| e.height_m), "eruptions_per_s": e.map(|e| e.link.eruptions_per_s),
+        "eruption_height_m": e.map(|e| e.fronts.height_m), "eruptions_per_s": e.map(|e| e.fronts.count.per_second),
         "dp_cycles_per_eruption": e.and_then(|e| e.dp_frequency_per_eruption),
         "swing_pa": e.map(|e| e.link.swing_pa), "lag_of_dp_max_s": e.map(|e| e.link.lag_of_max_s),
         "lag_of_dp_min_s": e.map(|e| e.link.lag_of_min_s)})
@@ -46,10 +46,10 @@ pub fn run() -> Value {
     let mut slugging = Vec::new();
     for u in [0.54, 0.60] {
         match crate::slug_rise::finished_at(u) {
-            Some(a) => {
+            Some(done) => {
                 let p = point(
                     &format!("22-mm bed, 90 mm settled, U = {u} m/s"),
-                    &a,
+                    &done.analysis,
                     &format!("docs/img/pressure_oscillation_22mm_U{u}.png"),
                 );
                 println!("{p}");

@@ -38,10 +38,10 @@ struct Kept {
 }
 
 /// A finished run: what it kept and the analysis of its last checkpoint.
-struct Finished {
+pub struct Finished {
     particles: usize,
     wall_s: f64,
-    analysis: AnalysisReport,
+    pub analysis: AnalysisReport,
 }
 
 /// The slugging bed at superficial velocity `u`.
@@ -78,12 +78,13 @@ fn cache_path(u: f64) -> String {
     format!("target/validate-cache/slug-rise-U{u}-{key:016x}.bin")
 }
 
-/// The analysis of the finished run at `u`, if it has finished (never starts it).
-pub fn finished_at(u: f64) -> Option<AnalysisReport> {
+/// The finished run at `u`, if it has finished (never starts it).
+pub fn finished_at(u: f64) -> Option<Finished> {
     let cache = cache_path(u);
-    bincode::deserialize::<Kept>(&std::fs::read(&cache).ok()?).ok()?;
+    let kept = bincode::deserialize::<Kept>(&std::fs::read(&cache).ok()?).ok()?;
     let bytes = std::fs::read(format!("{cache}.ckpt")).ok()?;
-    Simulation::analysis_of_checkpoint(&bytes, None).ok().map(|(_, _, a)| a)
+    let (_, _, analysis) = Simulation::analysis_of_checkpoint(&bytes, None).ok()?;
+    Some(Finished { particles: kept.particles, wall_s: kept.wall_s, analysis })
 }
 
 /// The run at `u`, from the cache, resumed from its checkpoint or run now.
@@ -91,10 +92,9 @@ fn run_at(u: f64) -> Finished {
     let case = case(u);
     let cache = cache_path(u);
     let ckpt = format!("{cache}.ckpt");
-    let kept = std::fs::read(&cache).ok().and_then(|b| bincode::deserialize::<Kept>(&b).ok());
-    if let (Some(k), Some(analysis)) = (kept, finished_at(u)) {
+    if let Some(done) = finished_at(u) {
         eprintln!("[slug-rise U={u}] using the run kept in {cache} and {ckpt} (delete them to run again)");
-        return Finished { particles: k.particles, wall_s: k.wall_s, analysis };
+        return done;
     }
     // The wall time so far rides in the checkpoint's file name's sibling.
     let wall_file = format!("{cache}.wall");
@@ -164,7 +164,7 @@ pub fn run() -> serde_json::Value {
                 "stewart_davidson_m_s": want, "rel_err": err, "peak": r.map(|r| r.peak), "delay_s": r.map(|r| r.delay_s),
                 "heights_m": rise.map(|r| [r.lower_m, r.upper_m]), "bed_height_m": k.analysis.bed_height_m,
                 "dp_dominant_hz": k.analysis.pressure_drop.as_ref().and_then(|p| p.dominant_frequency_hz),
-                "eruptions_per_s": k.analysis.eruptions.as_ref().map(|e| e.link.eruptions_per_s),
+                "eruptions_per_s": k.analysis.eruptions.as_ref().map(|e| e.fronts.count.per_second),
                 "dp_cycles_per_eruption": k.analysis.eruptions.as_ref().and_then(|e| e.dp_frequency_per_eruption),
                 "window_s": [k.analysis.from_s, k.analysis.to_s], "wall_s": k.wall_s})
         );

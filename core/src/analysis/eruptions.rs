@@ -1,23 +1,19 @@
 //! Bubble eruptions at the bed surface against the bed pressure drop (paper section 3.4, Fig. 9:
 //! the period of the ΔP oscillation matches the time for bubbles to erupt at the top of the bed,
 //! as Müller et al. 2007b measured). An eruption is a bubble front passing a height just below the
-//! surface (`count_bubbles` on the cross-section voidage there). The link is measured two ways:
+//! surface (`count_bubbles` on the cross-section voidage there, which the caller runs). The link
+//! is measured two ways:
 //! - the eruption-triggered average of ΔP: A(τ) = mean over eruptions e of ΔP(t_e + τ) − ΔP̄ for
 //!   |τ| ≤ W, over the eruptions whose window lies inside the record; its maximum and minimum and
 //!   their lags say whether ΔP peaks or drops as bubbles break the surface, and by how much;
 //! - the ratio of ΔP's dominant frequency to the eruption rate (1 when every eruption makes one
 //!   ΔP cycle, ½ when the ΔP period spans a pair of eruptions, the paper's case).
 
-use super::bubble_count::count_bubbles;
 use serde::{Deserialize, Serialize};
 
+/// ΔP around the eruptions: the eruption-triggered average and its extremes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct EruptionLink {
-    /// Eruptions found in the record and their rate (per s).
-    pub eruptions: usize,
-    pub eruptions_per_s: f64,
-    /// Time of each eruption from the record's start (s).
-    pub eruptions_s: Vec<f64>,
     /// Eruptions whose window [t_e − W, t_e + W] lies inside the record (those averaged).
     pub averaged: usize,
     /// The lags τ = −W … W (step dt) and the triggered average A(τ) (Pa) at each.
@@ -29,29 +25,20 @@ pub struct EruptionLink {
     pub swing_pa: f64,
 }
 
-/// The eruption link of a ΔP record `dp` and the cross-section voidage `surface` just below the
-/// bed surface, both sampled every `dt`; eruptions are fronts through `rise` after `fall`
-/// (`count_bubbles`), the window half-width is `half_window_s`. `None` when no eruption's window
-/// fits in the record.
-pub fn eruption_link(
-    dp: &[f64],
-    surface: &[f64],
-    dt: f64,
-    rise: f64,
-    fall: f64,
-    half_window_s: f64,
-) -> Option<EruptionLink> {
-    let n = dp.len().min(surface.len());
-    if n < 2 || dt <= 0.0 || fall >= rise {
+/// The eruption-triggered average of the ΔP record `dp` (sampled every `dt`) over the eruptions
+/// at `eruptions_s` (from the record's start, e.g. `count_bubbles(..).fronts_s` of the voidage
+/// just below the surface), each rounded to its nearest sample, with half-width `half_window_s`.
+/// `None` when no eruption's window fits in the record.
+pub fn eruption_link(dp: &[f64], eruptions_s: &[f64], dt: f64, half_window_s: f64) -> Option<EruptionLink> {
+    let n = dp.len();
+    if n < 2 || dt <= 0.0 {
         return None;
     }
-    let (dp, surface) = (&dp[..n], &surface[..n]);
-    let count = count_bubbles(surface, dt, rise, fall);
     let w = (half_window_s / dt).round() as isize;
     let mean = dp.iter().sum::<f64>() / n as f64;
     let mut sum = vec![0.0; (2 * w + 1) as usize];
     let mut averaged = 0usize;
-    for &t in &count.fronts_s {
+    for &t in eruptions_s {
         let c = (t / dt).round() as isize;
         if c - w < 0 || c + w >= n as isize {
             continue;
@@ -71,9 +58,6 @@ pub fn eruption_link(
     };
     let (hi, lo) = (arg(|a, b| a > b), arg(|a, b| a < b));
     Some(EruptionLink {
-        eruptions: count.bubbles,
-        eruptions_per_s: count.per_second,
-        eruptions_s: count.fronts_s,
         averaged,
         lag_of_max_s: lag_s[hi],
         lag_of_min_s: lag_s[lo],
@@ -86,6 +70,7 @@ pub fn eruption_link(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::analysis::bubble_count::count_bubbles;
     use crate::analysis::test_signals::Noise;
 
     /// Eruptions at irregular known times (mean 0.2 s apart); the surface voidage jumps from 0.45
@@ -122,25 +107,27 @@ mod tests {
         for p in dp.iter_mut() {
             *p += noise.gauss();
         }
-        let l = eruption_link(&dp, &surface, dt, 0.7, 0.5, 0.1).expect("eruptions");
-        assert_eq!(l.eruptions, times.len());
-        for (a, b) in l.eruptions_s.iter().zip(&times) {
+        let fronts = count_bubbles(&surface, dt, 0.7, 0.5);
+        let l = eruption_link(&dp, &fronts.fronts_s, dt, 0.1).expect("eruptions");
+        assert_eq!(fronts.bubbles, times.len());
+        for (a, b) in fronts.fronts_s.iter().zip(&times) {
             assert!((a - b).abs() <= dt, "eruption at {a} s, made at {b} s");
         }
-        assert!((l.eruptions_per_s - times.len() as f64 / secs).abs() < 1e-9);
+        assert!((fronts.per_second - times.len() as f64 / secs).abs() < 1e-9);
         assert!((l.lag_of_max_s - lag).abs() <= 2.0 * dt, "peak at {} s", l.lag_of_max_s);
         assert!((-0.02..0.0).contains(&l.lag_of_min_s), "dip at {} s", l.lag_of_min_s);
         // Within ±0.1 s of an eruption only its own bump and dip (the next is ≥ 0.15 s away).
         let want = bump + dip;
         assert!((l.swing_pa / want - 1.0).abs() < 0.03, "swing {} Pa vs {want} Pa", l.swing_pa);
         assert_eq!(l.lag_s.len(), 201);
-        assert!(l.averaged + 2 >= l.eruptions);
+        assert!(l.averaged + 2 >= fronts.bubbles);
     }
 
     #[test]
     fn a_record_without_eruptions_gives_none() {
         let dp = vec![100.0; 500];
         let eps = vec![0.45; 500];
-        assert!(eruption_link(&dp, &eps, 0.001, 0.7, 0.5, 0.05).is_none());
+        let fronts = count_bubbles(&eps, 0.001, 0.7, 0.5);
+        assert!(eruption_link(&dp, &fronts.fronts_s, 0.001, 0.05).is_none());
     }
 }

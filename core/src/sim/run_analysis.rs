@@ -95,14 +95,11 @@ pub struct Bubbles {
     pub count: BubbleCount,
 }
 
-/// Eruptions where the cross-section voidage at `height_m` (0.9 of the bed height) rises through
-/// its mean + one standard deviation after it was below its mean, and the triggered average of ΔP
-/// over one mean eruption period (at most 0.5 s) each side.
+/// Eruptions: the bubble fronts at 0.9 of the bed height (counted as `bubbles` is), and the
+/// triggered average of ΔP over one mean eruption period (at most 0.5 s) each side.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Eruptions {
-    pub height_m: f64,
-    pub rise: f64,
-    pub fall: f64,
+    pub fronts: Bubbles,
     pub link: EruptionLink,
     /// ΔP's dominant frequency over the eruption rate (1: one ΔP cycle per eruption).
     pub dp_frequency_per_eruption: Option<f64>,
@@ -252,17 +249,11 @@ impl RunAnalysis {
     }
 
     fn eruptions_at(&self, z: f64, dt: f64, skip: usize, dp: &[f64], dp_hz: Option<f64>) -> Option<Eruptions> {
-        let x = self.voidage_layers.at_height(z).split_off(skip);
-        let st = signal_stats(&x)?;
-        let (rise, fall) = (st.mean + st.std, st.mean);
-        if rise <= fall {
-            return None;
-        }
-        let rate = count_bubbles(&x, dt, rise, fall).per_second;
-        let half = if rate > 0.0 { (1.0 / rate).min(0.5) } else { 0.5 };
-        let link = eruption_link(dp, &x, dt, rise, fall, half)?;
-        let per = dp_hz.filter(|_| link.eruptions_per_s > 0.0).map(|f| f / link.eruptions_per_s);
-        Some(Eruptions { height_m: z, rise, fall, link, dp_frequency_per_eruption: per })
+        let fronts = self.bubbles_at(z, dt, skip)?;
+        let rate = fronts.count.per_second;
+        let link = eruption_link(dp, &fronts.count.fronts_s, dt, (1.0 / rate).min(0.5))?;
+        let dp_frequency_per_eruption = dp_hz.map(|f| f / rate);
+        Some(Eruptions { fronts, link, dp_frequency_per_eruption })
     }
 }
 
@@ -280,6 +271,16 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
+    /// One sample at `t` of a column whose pressure is linear in the layer index, so that its bed
+    /// drop (plate to the top two layers' mean) is `dp` over nz − 1 layers.
+    fn add_sample(a: &mut RunAnalysis, grid: &CylGrid, t: f64, eps: &[f64], dp: f64, particles: [&[[f64; 3]]; 2]) {
+        let (per, slope) = (grid.cells_per_layer(), dp / (grid.nz as f64 - 1.0));
+        let p: Vec<f64> = (0..grid.num_cells()).map(|c| 1e5 - slope * (c / per) as f64).collect();
+        let [positions, velocities] = particles;
+        let s = Sample { time_s: t, voidage: eps, pressure_pa: Some(&p), gas_velocity: None, positions, velocities };
+        a.add(grid, &s);
+    }
+
     /// A ΔP of 100 + 10 sin(2π·4 t) Pa before 0.5 s and 200 + 20 sin(2π·10 t) Pa after: the report
     /// from 0.5 s has the second signal's statistics, the whole report their mixture.
     #[test]
@@ -291,7 +292,7 @@ mod tests {
         .unwrap();
         let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
         let mut a = RunAnalysis::new(&case, &grid);
-        let (n, per) = (grid.num_cells(), grid.cells_per_layer());
+        let n = grid.num_cells();
         let eps = vec![0.4; n];
         let none: Vec<[f64; 3]> = vec![];
         for step in 0..1000u64 {
@@ -301,17 +302,7 @@ mod tests {
             } else {
                 200.0 + 20.0 * (2.0 * PI * 10.0 * t).sin()
             };
-            let slope = dp / (grid.nz as f64 - 1.0);
-            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
-            let s = Sample {
-                time_s: t,
-                voidage: &eps,
-                pressure_pa: Some(&p),
-                gas_velocity: None,
-                positions: &none,
-                velocities: &none,
-            };
-            a.add(&grid, &s);
+            add_sample(&mut a, &grid, t, &eps, dp, [&none, &none]);
         }
         let late = a.report_from(&grid, Some(0.5));
         assert_eq!((late.series_samples, late.samples), (500, 1000));
@@ -345,7 +336,6 @@ mod tests {
         let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
         let mut a = RunAnalysis::new(&case, &grid);
         let n = grid.num_cells();
-        let per = grid.cells_per_layer();
         let (mut t, mut taken) = (0.0, 0);
         // Samples at 0.05, 0.052, … 1.048 s: 500 samples, five whole periods of the ΔP signal.
         for step in 1..=104_800u64 {
@@ -362,24 +352,10 @@ mod tests {
                     _ => 0.4,
                 })
                 .collect();
-            // p linear in the layer index: the bed drop (plate to the top two layers' mean) is
-            // slope · (nz − 1) layers.
             let dp = 100.0 + 10.0 * (2.0 * PI * 5.0 * t).sin();
-            let slope = dp / (grid.nz as f64 - 1.0);
-            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
             let pos: Vec<[f64; 3]> = (0..n).map(|c| grid.centre_xyz(c)).collect();
             let vel: Vec<[f64; 3]> = pos.iter().map(|x| [0.0, 0.0, 0.2 - 10.0 * (x[0] * x[0] + x[1] * x[1])]).collect();
-            a.add(
-                &grid,
-                &Sample {
-                    time_s: t,
-                    voidage: &eps,
-                    pressure_pa: Some(&p),
-                    gas_velocity: None,
-                    positions: &pos,
-                    velocities: &vel,
-                },
-            );
+            add_sample(&mut a, &grid, t, &eps, dp, [&pos, &vel]);
         }
         let r = a.report(&grid);
         assert_eq!(r.samples, taken);
@@ -428,7 +404,7 @@ mod tests {
         .unwrap();
         let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
         let mut a = RunAnalysis::new(&case, &grid);
-        let (n, per) = (grid.num_cells(), grid.cells_per_layer());
+        let n = grid.num_cells();
         let none: Vec<[f64; 3]> = vec![];
         for step in 0..=2050u64 {
             let t = step as f64 * 1e-3;
@@ -444,24 +420,15 @@ mod tests {
                 })
                 .collect();
             let dp = 100.0 + 10.0 * (2.0 * PI * 10.0 * t).sin();
-            let slope = dp / (grid.nz as f64 - 1.0);
-            let p: Vec<f64> = (0..n).map(|c| 1e5 - slope * (c / per) as f64).collect();
-            let s = Sample {
-                time_s: t,
-                voidage: &eps,
-                pressure_pa: Some(&p),
-                gas_velocity: None,
-                positions: &none,
-                velocities: &none,
-            };
-            a.add(&grid, &s);
+            add_sample(&mut a, &grid, t, &eps, dp, [&none, &none]);
         }
         let r = a.report(&grid);
         let e = r.eruptions.as_ref().expect("eruptions");
-        assert!((e.height_m - 0.9 * 0.012).abs() < 1e-12, "height {}", e.height_m);
+        assert!((e.fronts.height_m - 0.9 * 0.012).abs() < 1e-12, "height {}", e.fronts.height_m);
         // Fronts at 0.1, 0.2, … 2.0 s: 20 in a record of 2.0 s.
-        assert_eq!(e.link.eruptions, 20, "{:?}", e.link.eruptions_s);
-        assert!((e.link.eruptions_per_s - 10.0).abs() < 0.1, "{}", e.link.eruptions_per_s);
+        let count = &e.fronts.count;
+        assert_eq!(count.bubbles, 20, "{:?}", count.fronts_s);
+        assert!((count.per_second - 10.0).abs() < 0.1, "{}", count.per_second);
         assert!((e.link.swing_pa - 20.0).abs() < 0.2, "swing {}", e.link.swing_pa);
         let ratio = e.dp_frequency_per_eruption.expect("ratio");
         assert!((ratio - 1.0).abs() < 0.05, "ΔP cycles per eruption {ratio}");

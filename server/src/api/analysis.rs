@@ -9,20 +9,11 @@ use axum::extract::{Path, Query, State};
 use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::Json;
-use fluidbed_api::AnalysisQuery;
+use fluidbed_api::{AnalysisQuery, ANALYSIS_FIGURES as FIGURES};
 use fluidbed_core::grid::CylGrid;
 use fluidbed_core::output::plot;
 use fluidbed_core::sim::{AnalysisReport, Simulation};
 use std::sync::Arc;
-
-/// The figures `GET /v1/jobs/{id}/analysis/{figure}` draws.
-const FIGURES: [&str; 5] = [
-    "pressure_spectrum.png",
-    "rise_correlation.png",
-    "eruption_link.png",
-    "particle_velocity_map.png",
-    "voidage_map.png",
-];
 
 /// The report of the job's last checkpoint, or the problem to answer with.
 async fn report(app: &Arc<App>, id: &str, q: &AnalysisQuery) -> Result<(CylGrid, AnalysisReport, String), Response> {
@@ -157,8 +148,8 @@ fn draw(grid: &CylGrid, r: &AnalysisReport, job_name: &str, figure: &str) -> Res
             let title = format!(
                 "{job_name}: ΔP around {} eruptions at {:.0} mm ({:.2} /s), {series}",
                 e.link.averaged,
-                1e3 * e.height_m,
-                e.link.eruptions_per_s
+                1e3 * e.fronts.height_m,
+                e.fronts.count.per_second
             );
             let labels =
                 plot::TraceLabels {
