@@ -271,6 +271,18 @@ mod tests {
     use super::*;
     use std::f64::consts::PI;
 
+    /// The analysis of a 20-mm column (4 annuli of 2.5 mm, 3 cells in the first, layers of 2 mm,
+    /// 30 mm tall) stepped at `dt` and sampled every `interval` s from `from_s`.
+    fn small_column(dt: f64, from_s: f64, interval: f64) -> (RunAnalysis, CylGrid) {
+        let case: Case = serde_json::from_value(serde_json::json!({
+            "column": {"diameter_m": 0.02, "height_m": 0.03}, "particles": {},
+            "bed": {"generated": {"settled_height_m": 0.01}}, "dem": {"time_step_s": dt},
+            "analysis": {"from_s": from_s, "sample_interval_s": interval}}))
+        .unwrap();
+        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
+        (RunAnalysis::new(&case, &grid), grid)
+    }
+
     /// One sample at `t` of a column whose pressure is linear in the layer index, so that its bed
     /// drop (plate to the top two layers' mean) is `dp` over nz − 1 layers.
     fn add_sample(a: &mut RunAnalysis, grid: &CylGrid, t: f64, eps: &[f64], dp: f64, particles: [&[[f64; 3]]; 2]) {
@@ -285,13 +297,7 @@ mod tests {
     /// from 0.5 s has the second signal's statistics, the whole report their mixture.
     #[test]
     fn a_later_start_gives_the_time_series_statistics_of_that_window_only() {
-        let case: Case = serde_json::from_str(
-            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
-               "dem":{"time_step_s":1e-3},"analysis":{"from_s":0.0,"sample_interval_s":0.001}}"#,
-        )
-        .unwrap();
-        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
-        let mut a = RunAnalysis::new(&case, &grid);
+        let (mut a, grid) = small_column(1e-3, 0.0, 0.001);
         let n = grid.num_cells();
         let eps = vec![0.4; n];
         let none: Vec<[f64; 3]> = vec![];
@@ -328,13 +334,7 @@ mod tests {
     /// 100 + 10 sin(2π·5 t) Pa, particles moving up at v_z = 0.2 − 10 r² (m/s).
     #[test]
     fn a_run_of_known_samples_gives_its_mean_spread_frequency_bed_height_and_particle_map() {
-        let case: Case = serde_json::from_str(
-            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
-               "dem":{"time_step_s":1e-5},"analysis":{"from_s":0.05,"sample_interval_s":0.002}}"#,
-        )
-        .unwrap();
-        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
-        let mut a = RunAnalysis::new(&case, &grid);
+        let (mut a, grid) = small_column(1e-5, 0.05, 0.002);
         let n = grid.num_cells();
         let (mut t, mut taken) = (0.0, 0);
         // Samples at 0.05, 0.052, … 1.048 s: 500 samples, five whole periods of the ΔP signal.
@@ -397,13 +397,7 @@ mod tests {
     /// triggered average is 10 sin(2π·10 τ): swing 20 Pa, and one ΔP cycle per eruption.
     #[test]
     fn eruptions_at_the_surface_are_counted_and_linked_to_the_pressure_drop() {
-        let case: Case = serde_json::from_str(
-            r#"{"column":{"diameter_m":0.02,"height_m":0.03},"particles":{},"bed":{"generated":{"settled_height_m":0.01}},
-               "dem":{"time_step_s":1e-3},"analysis":{"from_s":0.05,"sample_interval_s":0.002}}"#,
-        )
-        .unwrap();
-        let grid = CylGrid::new(0.01, 0.03, 0.0025, 0.002, 3);
-        let mut a = RunAnalysis::new(&case, &grid);
+        let (mut a, grid) = small_column(1e-3, 0.05, 0.002);
         let n = grid.num_cells();
         let none: Vec<[f64; 3]> = vec![];
         for step in 0..=2050u64 {
