@@ -20,8 +20,9 @@ use fluidbed_core::sim::{AnalysisReport, Simulation};
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 
-/// Superficial velocities (m/s): 1.2, 1.4, 1.8 and 2 U_mf, the paper's slugging set.
-const VELOCITIES: [f64; 4] = [0.37, 0.425, 0.54, 0.60];
+/// Superficial velocities (m/s): 1.8, 2, 1.4 and 1.2 U_mf, the paper's slugging set, run in this
+/// order: the clearest slugs first, and the two that `pressure-oscillation` reads.
+const VELOCITIES: [f64; 4] = [0.54, 0.60, 0.425, 0.37];
 /// U_mf of the formula (the paper's measured value; `validate -- umf` for the model's).
 const UMF: f64 = 0.30;
 /// Start of the analysis window (after the 0.24-s ramp and the first slugs) and the end.
