@@ -45,18 +45,29 @@ pub fn case() -> fluidbed_core::case::Case {
     }
 }
 
-/// The run of the bubbling case to `end_s`, from the cache or run now.
-pub fn run_to(end_s: f64) -> RunSummary {
+/// The bubbling case as the run to `end_s` runs it, and where that run is kept (named after the
+/// case it ran, so an edited case runs anew). Bincode, not JSON: the analysis holds NaN where a
+/// figure has no value, which JSON would write as null and then not read back.
+fn run_case(end_s: f64) -> (fluidbed_core::case::Case, String) {
     let mut case = case();
     case.end_time_s = end_s;
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
     case.analysis.from_s = ANALYSIS_FROM_S;
-    // named after the case it ran, so an edited case runs anew
     let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
-    // bincode, not JSON: the analysis holds NaN where a figure has no value, which JSON would
-    // write as null and then not read back.
-    let cache = format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.bin");
+    (case, format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.bin"))
+}
+
+/// The last checkpoint of the finished run to `end_s`, if it has finished.
+pub fn kept_checkpoint(end_s: f64) -> Option<Vec<u8>> {
+    let (_, cache) = run_case(end_s);
+    std::fs::metadata(&cache).ok()?;
+    std::fs::read(format!("{cache}.ckpt")).ok()
+}
+
+/// The run of the bubbling case to `end_s`, from the cache or run now.
+pub fn run_to(end_s: f64) -> RunSummary {
+    let (case, cache) = run_case(end_s);
     let cache = cache.as_str();
     let (ckpt, partial) = (format!("{cache}.ckpt"), format!("{cache}.partial"));
     if let Ok(bytes) = std::fs::read(cache) {

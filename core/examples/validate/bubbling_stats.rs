@@ -3,7 +3,9 @@
 //! from t = 0.4 s: bubbles per second at 30% of the bed height against the paper's 17 bubbles in
 //! 2.1 s (section 3.2, ≈ 8.1 per second), beside the ΔP statistics, the rise velocity and the
 //! particle-based velocity map on the axial plane (upflow at the centre, downflow at the wall, as
-//! the paper's Fig. 7), drawn to docs/img/bubbling_particle_vz.png and docs/img/bubbling_voidage_mean.png.
+//! the paper's Fig. 7), drawn to docs/img/bubbling_particle_vz.png and docs/img/bubbling_voidage_mean.png;
+//! and the gas through the bubbles against the paper's "roughly 1.5 m/s" (section 3.2, Fig. 4),
+//! from the run continued past its end (`gas_through_bubbles`).
 
 use fluidbed_core::output::plot;
 use fluidbed_core::sim::fluid_grid;
@@ -11,6 +13,13 @@ use serde_json::json;
 
 /// The paper's count: 17 bubbles in 2.1 s.
 const PAPER_BUBBLES_PER_S: f64 = 17.0 / 2.1;
+/// The paper's gas velocity through a bubble (U = 0.6 m/s through ≈ 40% of the cross-section).
+const PAPER_BUBBLE_GAS_M_S: f64 = 1.5;
+/// How long the run is continued from its last checkpoint to sample the gas in the bubbles.
+const GAS_WINDOW_S: f64 = 0.2;
+/// A bubble cell: ε above this (as the bubble count); a dense cell: ε below `DENSE`.
+const BUBBLE: f64 = 0.8;
+const DENSE: f64 = 0.5;
 
 pub fn run() -> serde_json::Value {
     let r = crate::bubbling::run_to(crate::bubbling::end_s());
@@ -45,7 +54,44 @@ pub fn run() -> serde_json::Value {
         "dp_dominant_hz": a.pressure_drop.as_ref().and_then(|p| p.dominant_frequency_hz),
         "bed_height_m": a.bed_height_m,
         "rise_velocity_m_s": a.rise_velocity.as_ref().and_then(|x| x.voidage.as_ref()).map(|v| v.velocity_m_s),
-        "vz_centre_m_s": centre, "vz_wall_m_s": wall})
+        "vz_centre_m_s": centre, "vz_wall_m_s": wall,
+        "gas_through_bubbles": gas_through_bubbles(a.bed_height_m.unwrap_or(0.03)),
+        "paper_bubble_gas_m_s": PAPER_BUBBLE_GAS_M_S})
+}
+
+/// The run continued from its last checkpoint for `GAS_WINDOW_S`: at every 5-ms snapshot the
+/// interstitial u_z of the bubble cells (ε > 0.8) and the dense cells (ε < 0.5) below 90% of the
+/// time-averaged bed height `bed_m`, pooled over the snapshots: their means, the bubble cells'
+/// 90th percentile and how many cells of each were seen. Null if the run has not finished.
+fn gas_through_bubbles(bed_m: f64) -> serde_json::Value {
+    let Some(bytes) = crate::bubbling::kept_checkpoint(crate::bubbling::end_s()) else {
+        return serde_json::Value::Null;
+    };
+    let mut sim = fluidbed_core::sim::Simulation::restore(&bytes).expect("the kept checkpoint restores");
+    let t0 = sim.time();
+    sim.set_end_time(t0 + GAS_WINDOW_S);
+    let (mut bubble, mut dense, mut snapshots) = (Vec::new(), Vec::new(), 0);
+    while !sim.is_finished() {
+        let Some(s) = sim.advance(u64::MAX).expect("the continued run") else { continue };
+        let eps = s.voidage.as_ref().expect("voidage field");
+        let gas = sim.gas().expect("gas");
+        let cells = ((0.9 * bed_m / gas.grid().dz).floor() as usize * gas.grid().cells_per_layer()).min(eps.len());
+        for (c, &e) in eps[..cells].iter().enumerate() {
+            let uz = gas.velocity_cyl(c)[2];
+            if e > BUBBLE {
+                bubble.push(uz);
+            } else if e < DENSE {
+                dense.push(uz);
+            }
+        }
+        snapshots += 1;
+    }
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    bubble.sort_by(f64::total_cmp);
+    let p90 = bubble.get((0.9 * bubble.len() as f64) as usize).copied();
+    json!({"window_s": [t0, sim.time()], "snapshots": snapshots, "bubble_cells": bubble.len(),
+        "bubble_uz_mean_m_s": mean(&bubble), "bubble_uz_p90_m_s": p90,
+        "dense_cells": dense.len(), "dense_uz_mean_m_s": mean(&dense)})
 }
 
 fn save(path: &str, png: Vec<u8>) {
