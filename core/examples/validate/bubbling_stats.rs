@@ -70,12 +70,13 @@ fn gas_through_bubbles(bed_m: f64) -> serde_json::Value {
     let mut sim = fluidbed_core::sim::Simulation::restore(&bytes).expect("the kept checkpoint restores");
     let t0 = sim.time();
     sim.set_end_time(t0 + GAS_WINDOW_S);
+    let g = sim.grid().clone();
+    let cells = ((0.9 * bed_m / g.dz).floor() as usize * g.cells_per_layer()).min(g.num_cells());
     let (mut bubble, mut dense, mut snapshots) = (Vec::new(), Vec::new(), 0);
     while !sim.is_finished() {
         let Some(s) = sim.advance(u64::MAX).expect("the continued run") else { continue };
         let eps = s.voidage.as_ref().expect("voidage field");
         let gas = sim.gas().expect("gas");
-        let cells = ((0.9 * bed_m / gas.grid().dz).floor() as usize * gas.grid().cells_per_layer()).min(eps.len());
         for (c, &e) in eps[..cells].iter().enumerate() {
             let uz = gas.velocity_cyl(c)[2];
             if e > BUBBLE {
@@ -86,7 +87,7 @@ fn gas_through_bubbles(bed_m: f64) -> serde_json::Value {
         }
         snapshots += 1;
     }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     bubble.sort_by(f64::total_cmp);
     let p90 = bubble.get((0.9 * bubble.len() as f64) as usize).copied();
     json!({"window_s": [t0, sim.time()], "snapshots": snapshots, "bubble_cells": bubble.len(),

@@ -34,7 +34,8 @@ pub fn eruption_link(dp: &[f64], eruptions_s: &[f64], dt: f64, half_window_s: f6
     if n < 2 || dt <= 0.0 {
         return None;
     }
-    let w = (half_window_s / dt).round() as isize;
+    // A window wider than the record fits no eruption (and must not size the sums).
+    let w = (half_window_s / dt).round().clamp(0.0, n as f64) as isize;
     let mean = dp.iter().sum::<f64>() / n as f64;
     let mut sum = vec![0.0; (2 * w + 1) as usize];
     let mut averaged = 0usize;
@@ -129,5 +130,8 @@ mod tests {
         let eps = vec![0.45; 500];
         let fronts = count_bubbles(&eps, 0.001, 0.7, 0.5);
         assert!(eruption_link(&dp, &fronts.fronts_s, 0.001, 0.05).is_none());
+        // A window of one over a zero rate (infinite) or wider than the record fits no eruption.
+        assert!(eruption_link(&dp, &[0.25], 0.001, f64::INFINITY).is_none());
+        assert!(eruption_link(&dp, &[0.25], 0.001, 1.0).is_none());
     }
 }

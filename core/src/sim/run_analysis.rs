@@ -249,7 +249,7 @@ impl RunAnalysis {
     }
 
     fn eruptions_at(&self, z: f64, dt: f64, skip: usize, dp: &[f64], dp_hz: Option<f64>) -> Option<Eruptions> {
-        let fronts = self.bubbles_at(z, dt, skip)?;
+        let fronts = self.bubbles_at(z, dt, skip).filter(|b| b.count.bubbles > 0)?;
         let rate = fronts.count.per_second;
         let link = eruption_link(dp, &fronts.count.fronts_s, dt, (1.0 / rate).min(0.5))?;
         let dp_frequency_per_eruption = dp_hz.map(|f| f / rate);
