@@ -190,7 +190,8 @@ pub fn parts() {
     time("voidage_from_solid", &mut || voidage_from_solid(grid, &solid, &mut eps));
     let (mut vel, mut rho, mut grad) = (vec![[0.0; 3]; n], vec![0.0; n], vec![[0.0; 3]; n]);
     let layers = fluidbed_core::coupling::layers_with_particles(grid, dem.positions());
-    time("gas_exchange_fields", &mut || gas.exchange_fields(layers, &mut vel, &mut rho, &mut grad));
+    let mut gas_fields = gas.clone();
+    time("gas_exchange_fields", &mut || gas_fields.exchange_fields(layers, &mut vel, &mut rho, &mut grad));
     let g = case.gas.as_ref().expect("gas");
     let par = ExchangeParams {
         law: case.coupling.drag_law,

@@ -74,9 +74,11 @@ pub struct Coupling {
     #[serde(default = "d_drag_sublayers")]
     pub drag_voidage_sublayers: u32,
     /// The gas's voidage between couplings: "held" (the paper's: each coupling's field at once;
-    /// the gas mass of each cell is held, so the change shows as a pressure step) or
+    /// the gas mass of each cell is held, so the change shows as a pressure step),
     /// "interpolated" (from the previous coupling's field to the new one over the next interval,
-    /// one interval behind the particles and without steps; cfd/voidage_ramp.rs).
+    /// one interval behind the particles and without steps) or "extrapolated" (the new field
+    /// moved on at the last interval's rate: no delay, steps of the second difference only;
+    /// cfd/voidage_ramp.rs).
     #[serde(default)]
     pub gas_voidage: GasVoidage,
 }
@@ -88,6 +90,7 @@ pub enum GasVoidage {
     #[default]
     Held,
     Interpolated,
+    Extrapolated,
 }
 
 impl Default for Coupling {

@@ -79,7 +79,12 @@ pub struct GasSolver {
     /// The gas's voidage between couplings when interpolated (voidage_ramp.rs); checkpointed
     /// beside the state.
     ramp: Option<VoidageRamp>,
+    /// Per cell (p, β/ε², εu) for `exchange_fields`, which reads each cell's several times.
+    face_inputs: Vec<FaceInputs>,
 }
+
+/// What the face pressures of `pressure_gradient_cyl` read of a cell: p, β/ε² and εu (Cartesian).
+type FaceInputs = (f64, f64, [f64; 3]);
 
 /// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
 const PARALLEL_MIN_CELLS: usize = 1_000;
@@ -150,6 +155,7 @@ impl GasSolver {
             pressure_offset: 0.0,
             budget: MassBudget::default(),
             ramp: None,
+            face_inputs: Vec::new(),
             grid,
         }
     }
@@ -214,8 +220,8 @@ impl GasSolver {
     }
     /// Voidage per cell reached over the `span` seconds from `start` (the coupling's time),
     /// starting from the previous ramp's end (voidage_ramp.rs); each step takes ε at its start.
-    pub fn ramp_voidage(&mut self, eps: &[f64], start: f64, span: f64) {
-        self.ramp = Some(VoidageRamp::next(self.ramp.take(), &self.st.eps, eps, start, span));
+    pub fn ramp_voidage(&mut self, eps: &[f64], start: f64, span: f64, extrapolated: bool) {
+        self.ramp = Some(VoidageRamp::next(self.ramp.take(), &self.st.eps, eps, start, span, extrapolated));
     }
     /// The voidage ramp (checkpoints).
     pub fn voidage_ramp(&self) -> Option<&VoidageRamp> {
@@ -302,36 +308,48 @@ impl GasSolver {
         [s[1] * f, s[2] * f, s[3] * f]
     }
 
+    /// What the face pressures read of `cell`.
+    #[inline]
+    fn face_inputs_of(&self, cell: usize) -> FaceInputs {
+        (self.pressure_at(cell), self.drag_over_eps2(cell), self.superficial_xyz(cell))
+    }
+
     /// ∇p at the cell centre as (∂p/∂r, (1/r)∂p/∂θ, ∂p/∂z): the Green–Gauss gradient of the
     /// momentum equation (rhs.rs `gradients_layer`: wall faces p_c, the ends as documented there).
     pub fn pressure_gradient_cyl(&self, cell: usize) -> [f64; 3] {
+        self.gradient_from(cell, |c| self.face_inputs_of(c))
+    }
+
+    /// `pressure_gradient_cyl` from the cells' (p, β/ε², εu) as `at` gives them.
+    #[inline(always)]
+    fn gradient_from(&self, cell: usize, at: impl Fn(usize) -> FaceInputs) -> [f64; 3] {
         let per = self.grid.cells_per_layer();
         let (c, k) = (cell % per, cell / per);
         let base = k * per;
-        let pc = self.pressure_at(cell);
-        let (bc, jc) = (self.drag_over_eps2(cell), self.superficial_xyz(cell));
+        let (pc, bc, jc) = at(cell);
         let (mut gx, mut gy) = (0.0, 0.0);
         for n in self.geo.neighbours(c) {
-            let nb = base + n.c as usize;
-            let jn = self.superficial_xyz(nb);
+            let (pn, bn, jn) = at(base + n.c as usize);
             let jd = 0.5 * ((jc[0] + jn[0]) * n.dx + (jc[1] + jn[1]) * n.dy);
-            let dp = 0.5 * (self.pressure_at(nb) - pc) + drag_weighted_face_pressure(bc, self.drag_over_eps2(nb), jd);
+            let dp = 0.5 * (pn - pc) + drag_weighted_face_pressure(bc, bn, jd);
             gx += dp * n.sx;
             gy += dp * n.sy;
         }
         let (nz, par, dz) = (self.grid.nz, &self.st.params, self.grid.dz);
         let a2 = par.sound_speed * par.sound_speed;
         let p_bot = if k == 0 {
-            inlet_face_pressure(pc, (nz > 1).then(|| self.pressure_at(cell + per)), par.gravity, dz, a2)
+            inlet_face_pressure(pc, (nz > 1).then(|| at(cell + per).0), par.gravity, dz, a2)
         } else {
-            let (b, jd) = (cell - per, 0.5 * (self.superficial_xyz(cell - per)[2] + jc[2]) * dz);
-            0.5 * (pc + self.pressure_at(b)) + drag_weighted_face_pressure(self.drag_over_eps2(b), bc, jd)
+            let (pb, bb, jb) = at(cell - per);
+            let jd = 0.5 * (jb[2] + jc[2]) * dz;
+            0.5 * (pc + pb) + drag_weighted_face_pressure(bb, bc, jd)
         };
         let p_top = if k + 1 < nz {
-            let (a, jd) = (cell + per, 0.5 * (jc[2] + self.superficial_xyz(cell + per)[2]) * dz);
-            0.5 * (pc + self.pressure_at(a)) + drag_weighted_face_pressure(bc, self.drag_over_eps2(a), jd)
+            let (pa, ba, ja) = at(cell + per);
+            let jd = 0.5 * (jc[2] + ja[2]) * dz;
+            0.5 * (pc + pa) + drag_weighted_face_pressure(bc, ba, jd)
         } else {
-            let p_below = if k > 0 { self.pressure_at(cell - per) } else { pc };
+            let p_below = if k > 0 { at(cell - per).0 } else { pc };
             top_face_pressure(par.outlet, pc, p_below, par.gravity, self.grid.dz, a2)
         };
         let gz = (p_top - p_bot) / self.grid.dz;
@@ -403,18 +421,30 @@ impl GasSolver {
     }
 
     /// What the particle–gas exchange reads per cell, in layers 0..layers (parallel over layers):
-    /// interstitial velocity (U_r, U_θ, U_z), density ρ and ∇p as `pressure_gradient_cyl`.
+    /// interstitial velocity (U_r, U_θ, U_z), density ρ and ∇p, the same bits as
+    /// `pressure_gradient_cyl` from each cell's face inputs computed once.
     pub fn exchange_fields(
-        &self,
+        &mut self,
         layers: usize,
         velocity_cyl: &mut [[f64; 3]],
         density: &mut [f64],
         grad_p_cyl: &mut [[f64; 3]],
     ) {
-        let per = self.grid.cells_per_layer();
-        let n = layers.min(self.grid.nz) * per;
+        let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
+        let layers = layers.min(nz);
+        let n = layers * per;
+        // The gradients of layer k read layers k − 1 ..= k + 1.
+        let read = (layers + 1).min(nz) * per;
+        let mut inputs = std::mem::take(&mut self.face_inputs);
+        inputs.resize(read, (0.0, 0.0, [0.0; 3]));
+        let rows = layers.div_ceil(rayon::current_num_threads().max(1)).max(1);
+        inputs.par_chunks_mut(per).with_min_len(rows).enumerate().for_each(|(k, row)| {
+            for (c, f) in row.iter_mut().enumerate() {
+                *f = self.face_inputs_of(k * per + c);
+            }
+        });
         let (velocity_cyl, density, grad_p_cyl) = (&mut velocity_cyl[..n], &mut density[..n], &mut grad_p_cyl[..n]);
-        let rows = (self.grid.nz / rayon::current_num_threads().max(1)).max(1);
+        let at = |c: usize| inputs[c];
         (velocity_cyl.par_chunks_mut(per), density.par_chunks_mut(per), grad_p_cyl.par_chunks_mut(per))
             .into_par_iter()
             .with_min_len(rows)
@@ -424,9 +454,10 @@ impl GasSolver {
                     let cell = k * per + c;
                     v[c] = self.velocity_cyl(cell);
                     r[c] = self.density(cell);
-                    g[c] = self.pressure_gradient_cyl(cell);
+                    g[c] = self.gradient_from(cell, at);
                 }
             });
+        self.face_inputs = inputs;
     }
 
     /// Advance by dt: Heun for the first step, then AB2, then AB3 with variable-step weights.

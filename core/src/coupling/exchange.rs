@@ -451,22 +451,30 @@ fn particle_block_pass<L: DragLaw>(
     let (mut re, mut f) = ([0.0; BLOCK], [0.0; BLOCK]);
     let mut slip = [[0.0; 3]; BLOCK];
     let mut rot = [(0.0, 0.0); BLOCK];
+    // What each lane reads (lanes past a short last block keep harmless earlier values).
+    let (mut x, mut y, mut rpw) = ([0.0; BLOCK], [0.0; BLOCK], [0.0; BLOCK]);
+    let (mut u_cyl, mut v) = ([[0.0; 3]; BLOCK], [[0.0; 3]; BLOCK]);
     for start in (0..pos.len()).step_by(BLOCK) {
         let m = BLOCK.min(pos.len() - start);
+        // The cells and their tables (scalar: the hint test and the gathers).
         for l in 0..m {
-            let (p, v) = (pos[start + l], vel[start + l]);
+            let p = pos[start + l];
             // The cell of the last call is a hint (particles move little; after a re-sort the
             // hint is another particle's and `locate_near` falls back to `locate`).
             let c = grid.locate_near(p[0], p[1], p[2], cell_of[start + l] as usize);
             cell_of[start + l] = c as u32;
             let t = &table[c];
-            let (cos, sin) = angle_of(p[0], p[1]);
-            let u = cyl_to_cart(t.u_cyl, cos, sin);
-            let s = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
-            re[l] = t.re_per_w * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+            (x[l], y[l], rpw[l], u_cyl[l], v[l]) = (p[0], p[1], t.re_per_w, t.u_cyl, vel[start + l]);
+            lane_cell[l] = t.law;
+        }
+        // Angle, slip and Re over the whole block (the square roots and division vectorise).
+        for l in 0..BLOCK {
+            let (cos, sin) = angle_of(x[l], y[l]);
+            let u = cyl_to_cart(u_cyl[l], cos, sin);
+            let s = [u[0] - v[l][0], u[1] - v[l][1], u[2] - v[l][2]];
+            re[l] = rpw[l] * (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
             slip[l] = s;
             rot[l] = (cos, sin);
-            lane_cell[l] = t.law;
         }
         for l in 0..BLOCK {
             f[l] = L::f_cell(&lane_cell[l], re[l]);

@@ -119,7 +119,8 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
             header.writer, header.format
         )
     };
-    let case = serde_json::from_slice(section("case")?).map_err(|e| refuse("case", e.to_string()))?;
+    let case: crate::case::Case =
+        serde_json::from_slice(section("case")?).map_err(|e| refuse("case", e.to_string()))?;
     let plan = bincode::deserialize(section("plan")?).map_err(|e| refuse("plan", e.to_string()))?;
     let (steps, snapshots_taken) =
         bincode::deserialize(section("counters")?).map_err(|e| refuse("counters", e.to_string()))?;
@@ -136,8 +137,11 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
     }
     // A checkpoint from before the voidage ramp (or of a run without one) holds the voidage.
     if let Some(body) = sections.get("gas_voidage_ramp") {
-        let ramp: Option<crate::cfd::VoidageRamp> =
+        let mut ramp: Option<crate::cfd::VoidageRamp> =
             bincode::deserialize(body).map_err(|e| refuse("gas_voidage_ramp", e.to_string()))?;
+        if let Some(r) = ramp.as_mut() {
+            r.set_extrapolated(case.coupling.gas_voidage == crate::case::GasVoidage::Extrapolated);
+        }
         if let Some(g) = gas.as_mut() {
             g.set_voidage_ramp(ramp);
         }

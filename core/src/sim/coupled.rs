@@ -124,8 +124,10 @@ impl Simulation {
         if moving || !self.buf.voidage_fresh {
             compute_voidage(&self.grid, self.voidage.as_mut(), &self.st.dem, &mut self.buf);
             let interval = self.st.plan.coupling_interval as f64 * self.st.case.dem.time_step_s;
-            if moving && self.st.case.coupling.gas_voidage == GasVoidage::Interpolated {
-                gas.ramp_voidage(&self.buf.voidage, self.st.steps as f64 * self.st.case.dem.time_step_s, interval);
+            let how = self.st.case.coupling.gas_voidage;
+            if moving && how != GasVoidage::Held {
+                let t = self.st.steps as f64 * self.st.case.dem.time_step_s;
+                gas.ramp_voidage(&self.buf.voidage, t, interval, how == GasVoidage::Extrapolated);
             } else {
                 gas.set_voidage(&self.buf.voidage);
             }

@@ -84,6 +84,7 @@ impl Plan {
             let gas = match case.coupling.gas_voidage {
                 crate::case::GasVoidage::Held => "held",
                 crate::case::GasVoidage::Interpolated => "interpolated",
+                crate::case::GasVoidage::Extrapolated => "extrapolated",
             };
             out.push(format!(
                 "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), the drag held in between and the gas's voidage {gas} (coupling.gas_voidage)",

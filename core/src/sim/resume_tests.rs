@@ -59,11 +59,14 @@ fn resume_with_a_slowed_acoustic_speed_reports_the_same_absolute_pressures() {
 }
 
 #[test]
-fn resume_with_the_gas_voidage_interpolated_is_bit_identical() {
-    // The cut falls inside a voidage ramp, which the checkpoint must carry.
-    let mut c = case();
-    c.coupling.gas_voidage = crate::case::GasVoidage::Interpolated;
-    resume_is_bit_identical(c);
+fn resume_with_the_gas_voidage_interpolated_or_extrapolated_is_bit_identical() {
+    // The cut falls inside a voidage ramp, which the checkpoint must carry (and the case says
+    // which way it runs).
+    for how in [crate::case::GasVoidage::Interpolated, crate::case::GasVoidage::Extrapolated] {
+        let mut c = case();
+        c.coupling.gas_voidage = how;
+        resume_is_bit_identical(c);
+    }
 }
 
 /// Run `case` straight and with a checkpoint and restore at `CUT`: the snapshots and the final
@@ -128,10 +131,12 @@ fn the_gas_caught_up_at_couplings_gives_the_same_bits_as_step_by_step() {
 }
 
 #[test]
-fn with_the_gas_voidage_interpolated_the_gas_caught_up_at_couplings_gives_the_same_bits() {
-    let mut c = case();
-    c.coupling.gas_voidage = crate::case::GasVoidage::Interpolated;
-    caught_up_equals_step_by_step(c);
+fn with_the_gas_voidage_ramped_the_gas_caught_up_at_couplings_gives_the_same_bits() {
+    for how in [crate::case::GasVoidage::Interpolated, crate::case::GasVoidage::Extrapolated] {
+        let mut c = case();
+        c.coupling.gas_voidage = how;
+        caught_up_equals_step_by_step(c);
+    }
 }
 
 fn caught_up_equals_step_by_step(case: Case) {

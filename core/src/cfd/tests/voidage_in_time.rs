@@ -40,7 +40,7 @@ fn a_held_voidage_steps_the_pressure_and_an_interpolated_one_ramps_it_to_the_sam
     let (q0, ramped) = bottom_pressures(
         |s, dt| {
             let t = s.time();
-            s.ramp_voidage(&vec![E1; s.grid().num_cells()], t, n as f64 * dt)
+            s.ramp_voidage(&vec![E1; s.grid().num_cells()], t, n as f64 * dt, false)
         },
         n + 2,
     );

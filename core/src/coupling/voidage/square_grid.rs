@@ -3,7 +3,7 @@
 //! or exactly (PHYSICS.md 3), then mapped to the cells with the box→cell fractions of `BoxGrid`.
 
 use super::box_grid::BoxGrid;
-use super::cuboid::{interval_split, split_two, Axis, MAX_SPAN};
+use super::cuboid::{interval_split, Axis, SplitTwo, MAX_SPAN};
 use super::sphere_box::sphere_box_volume;
 use super::{Scatter, VoidageMethod};
 use crate::case::BoxSplit;
@@ -103,17 +103,7 @@ fn two_stage_cuboid(
         let across = Axis::new(bg.origin, bg.dl, nb);
         if h <= bg.dl && h <= g.dz {
             // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
-            for p in &positions[lo..hi] {
-                let (sx, sy, sz) = (split_two(p[0], h, &across), split_two(p[1], h, &across), split_two(p[2], h, &up));
-                for &(k, wz) in &sz {
-                    for &(by, wy) in &sy {
-                        let row = (k * nb + by) * nb;
-                        for &(bx, wx) in &sx {
-                            buf[row + bx] += vp * wx * wy * wz;
-                        }
-                    }
-                }
-            }
+            deposit_small_cubes_on(&positions[lo..hi], SplitTwo::new(&across, h), SplitTwo::new(&up, h), nb, vp, buf);
             return;
         }
         for p in &positions[lo..hi] {
@@ -168,6 +158,52 @@ fn two_stage_cuboid(
             }
         }
     });
+}
+
+/// `deposit_small_cubes` compiled for AVX2 when the CPU has it and `FLUIDBED_KERNEL` allows: the
+/// same operations in the same order (no fused multiply-add), so the same bits.
+fn deposit_small_cubes_on(positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use crate::dem::Kernel;
+        if Kernel::from_env() != Kernel::Portable && std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has the feature the function is compiled for.
+            return unsafe { deposit_small_cubes_avx2(positions, across, up, nb, vp, buf) };
+        }
+    }
+    deposit_small_cubes(positions, across, up, nb, vp, buf)
+}
+
+/// # Safety
+/// The CPU has avx2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn deposit_small_cubes_avx2(
+    positions: &[[f64; 3]],
+    across: SplitTwo,
+    up: SplitTwo,
+    nb: usize,
+    vp: f64,
+    buf: &mut [f64],
+) {
+    deposit_small_cubes(positions, across, up, nb, vp, buf)
+}
+
+/// Each particle's cube (side h ≤ the box side and the layer height) onto its 2 × 2 × 2 boxes of
+/// `buf` (layer-major, rows of `nb` boxes): per layer and row the two boxes are neighbours.
+#[inline(always)]
+fn deposit_small_cubes(positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64]) {
+    for p in positions {
+        let ([(x0, wx0), (x1, wx1)], [(y0, wy0), (y1, wy1)], [(k0, wz0), (k1, wz1)]) =
+            (across.split(p[0]), across.split(p[1]), up.split(p[2]));
+        for (k, wz) in [(k0, vp * wz0), (k1, vp * wz1)] {
+            for (by, w) in [(y0, wz * wy0), (y1, wz * wy1)] {
+                let row = (k * nb + by) * nb;
+                buf[row + x0] += w * wx0;
+                buf[row + x1] += w * wx1;
+            }
+        }
+    }
 }
 
 /// Cube of side h: separable shares per axis (PHYSICS.md 4), then box → cells, particle by
@@ -269,6 +305,31 @@ mod two_stage_tests {
         }
         let total: f64 = fast.iter().sum();
         assert!((total / (vp * pos.len() as f64) - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn every_code_path_deposits_the_same_bits() {
+        // The portable deposit against the one this CPU runs, on a bed packed in the cell order.
+        let g = CylGrid::new(0.022, 0.0264, 0.0044, 0.0022, 3);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut pos: Vec<[f64; 3]> = (0..4000)
+            .map(|_| {
+                let (r, t) = (0.0216 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                [r * t.cos(), r * t.sin(), rng.gen_range(0.0..0.0264)]
+            })
+            .collect();
+        pos.sort_by(|a, b| a[2].total_cmp(&b[2]));
+        let bg = BoxGrid::new(&g, 0.0008);
+        let (across, up) = (Axis::new(bg.origin, bg.dl, bg.nb), Axis::new(0.0, g.dz, g.nz));
+        let h = 0.66 * 0.0012;
+        let (across, up) = (SplitTwo::new(&across, h), SplitTwo::new(&up, h));
+        let mut best = vec![0.0; bg.nb * bg.nb * g.nz];
+        let mut portable = best.clone();
+        deposit_small_cubes_on(&pos, across, up, bg.nb, 1.0, &mut best);
+        deposit_small_cubes(&pos, across, up, bg.nb, 1.0, &mut portable);
+        assert!(best.iter().zip(&portable).all(|(a, b)| a.to_bits() == b.to_bits()));
+        let total: f64 = best.iter().sum();
+        assert!((total - pos.len() as f64).abs() < 1e-9, "volume {total}");
     }
 
     #[test]
