@@ -10,8 +10,8 @@
 //!    to compare. `-- tradeoff errors|cost|voidage` runs one part (the voidage part always runs); `layer`
 //!    the reference and the fluid layer height point alone, `sound` the reference and the acoustic
 //!    speed points (the gas's pressure waves at f = ½ and ¼ of the sound speed, each from its own
-//!    spin-up) alone, `gas-voidage` the reference and the gas's voidage interpolated between
-//!    couplings at intervals 10, 20, 50 (and held at 50) alone.
+//!    spin-up) alone, `gas-voidage` the reference and the gas's voidage extrapolated,
+//!    interpolated and held between couplings at intervals 10, 20, 50 alone.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -244,9 +244,9 @@ fn layer_height_point(reference: &Case, r: Stats) {
     );
 }
 
-/// `-- tradeoff layer`: the reference window and the layer-height point alone.
-/// The gas's voidage interpolated between couplings (`coupling.gas_voidage`) at long intervals,
-/// beside the held voidage, against the paper's every-step reference and its noise floor.
+/// The gas's voidage extrapolated or interpolated between couplings (`coupling.gas_voidage`) at
+/// long intervals, beside the held voidage, against the paper's every-step reference and its
+/// noise floor (the extrapolated points first).
 fn gas_voidage_front() {
     let reference = bed(1);
     let (ref_snaps, ref_cost) = window(&reference, "tradeoff-seed1", 1);
@@ -263,10 +263,18 @@ fn gas_voidage_front() {
         json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
         "errors": errors(&stats(&floor_snaps, &grid), &r)})
     );
-    let (held, interpolated) = (GasVoidage::Held, GasVoidage::Interpolated);
-    for (how, interval) in
-        [(interpolated, 10u32), (interpolated, 20), (held, 10), (held, 20), (interpolated, 50), (held, 50)]
-    {
+    let (held, interpolated, extrapolated) = (GasVoidage::Held, GasVoidage::Interpolated, GasVoidage::Extrapolated);
+    for (how, interval) in [
+        (extrapolated, 20u32),
+        (extrapolated, 10),
+        (interpolated, 20),
+        (held, 10),
+        (interpolated, 10),
+        (held, 20),
+        (extrapolated, 50),
+        (interpolated, 50),
+        (held, 50),
+    ] {
         let (snaps, cost) = window_as(&reference, "tradeoff-seed1", interval, how);
         let s = stats(&snaps, &grid);
         println!(
@@ -277,6 +285,7 @@ fn gas_voidage_front() {
     }
 }
 
+/// `-- tradeoff layer`: the reference window and the layer-height point alone.
 fn layer_front() {
     let reference = bed(1);
     let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
