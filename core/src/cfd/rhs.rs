@@ -46,6 +46,8 @@ pub struct Primitives {
     /// Interphase coefficient per cell, β = |I|/|u| (0 without interaction force), for the face
     /// mass-flux correction.
     pub beta: Vec<f64>,
+    /// β/ε² per cell, which the drag-weighted face pressures read (`drag_weighted_face_pressure`).
+    pub beta_over_eps2: Vec<f64>,
 }
 
 impl Primitives {
@@ -60,7 +62,8 @@ impl Primitives {
             gx: z.clone(),
             gy: z.clone(),
             gz: z.clone(),
-            beta: z,
+            beta: z.clone(),
+            beta_over_eps2: z,
         }
     }
 
@@ -76,6 +79,7 @@ impl Primitives {
             gy: &self.gy,
             gz: &self.gz,
             beta: &self.beta,
+            beta_over_eps2: &self.beta_over_eps2,
         }
     }
 }
@@ -94,6 +98,7 @@ pub struct PrimView<'a> {
     pub gy: &'a [f64],
     pub gz: &'a [f64],
     pub beta: &'a [f64],
+    pub beta_over_eps2: &'a [f64],
 }
 
 /// Everything the right-hand side reads besides the state.

@@ -45,12 +45,14 @@ fn primitives_body(
     uz: &mut [f64],
     p: &mut [f64],
     beta: &mut [f64],
+    beta_over_eps2: &mut [f64],
 ) {
     let per = inp.per;
     let a2 = inp.params.sound_speed * inp.params.sound_speed;
     let r = k * per..(k + 1) * per;
     let (q, eps, force) = (&q[r.clone()], &inp.eps[r.clone()], &inp.force[r]);
     let (ux, uy, uz, p, beta) = (&mut ux[..per], &mut uy[..per], &mut uz[..per], &mut p[..per], &mut beta[..per]);
+    let beta_over_eps2 = &mut beta_over_eps2[..per];
     for c in 0..per {
         let s = q[c];
         let inv = 1.0 / s[0];
@@ -60,6 +62,7 @@ fn primitives_body(
         p[c] = a2 * s[0] / eps[c];
         // β for the face correction's relaxation and the drag-weighted face pressures.
         beta[c] = drag_coefficient(force[c], (x, y, z));
+        beta_over_eps2[c] = beta[c] / (eps[c] * eps[c]);
     }
 }
 
@@ -79,8 +82,8 @@ fn gradients_body(
     let a2 = par.sound_speed * par.sound_speed;
     let (ux, uy, uz, p) = (layer(pr.ux, per, k), layer(pr.uy, per, k), layer(pr.uz, per, k), layer(pr.p, per, k));
     let (div, gx, gy, gz) = (&mut div[..per], &mut gx[..per], &mut gy[..per], &mut gz[..per]);
-    // β/ε² per cell and ε per cell of this layer (`drag_weighted_face_pressure`).
-    let bz = |k: usize, c: usize| pr.beta[k * per + c] / (inp.eps[k * per + c] * inp.eps[k * per + c]);
+    // β/ε² per cell (`drag_weighted_face_pressure`) and ε per cell of this layer.
+    let bz = |k: usize, c: usize| pr.beta_over_eps2[k * per + c];
     let (eps, eps_b, eps_a) =
         (layer(inp.eps, per, k), layer(inp.eps, per, k.max(1) - 1), layer(inp.eps, per, (k + 1).min(nz - 1)));
     div.fill(0.0);
@@ -381,7 +384,7 @@ macro_rules! per_isa {
 per_isa!(
     /// Fill the primitive fields of one layer from the state.
     primitives_layer, primitives_paths, primitives_body,
-    (inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64], beta: &mut [f64])
+    (inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64], beta: &mut [f64], beta_over_eps2: &mut [f64])
 );
 per_isa!(
     /// ∇·u and ∇p of one layer's cells by Green–Gauss: (1/V) Σ φ_f S with face means; the tube

@@ -18,7 +18,7 @@ struct Fields {
     force: Vec<[f64; 3]>,
     face: Vec<f64>,
     q: Vec<[f64; 4]>,
-    prim: [Vec<f64>; 9],
+    prim: [Vec<f64>; 10],
     axial: Vec<[f64; 7]>,
 }
 
@@ -73,14 +73,14 @@ impl Fields {
         }
     }
     fn view(&self) -> PrimView<'_> {
-        let [ux, uy, uz, p, div, gx, gy, gz, beta] = &self.prim;
-        PrimView { ux, uy, uz, p, div, gx, gy, gz, beta }
+        let [ux, uy, uz, p, div, gx, gy, gz, beta, beta_over_eps2] = &self.prim;
+        PrimView { ux, uy, uz, p, div, gx, gy, gz, beta, beta_over_eps2 }
     }
 }
 
 /// The passes of one right-hand side on one path; every output's bits.
 type Passes = (
-    fn(&RhsInput, &[[f64; 4]], usize, &mut [f64], &mut [f64], &mut [f64], &mut [f64], &mut [f64]),
+    fn(&RhsInput, &[[f64; 4]], usize, &mut [f64], &mut [f64], &mut [f64], &mut [f64], &mut [f64], &mut [f64]),
     fn(&RhsInput, &PrimView, usize, &mut [f64], &mut [f64], &mut [f64], &mut [f64]),
     fn(&RhsInput, &[[f64; 4]], &PrimView, usize, &mut [[f64; 7]], &mut [f64]),
     fn(&RhsInput, &[[f64; 4]], &PrimView, &[[f64; 7]], usize, &mut [[f64; 4]], &mut [f64]),
@@ -92,7 +92,7 @@ fn run(f: &mut Fields, passes: Passes) -> Vec<u64> {
     let mut prim = std::mem::take(&mut f.prim);
     for k in 0..nz {
         let r = k * per..(k + 1) * per;
-        let [ux, uy, uz, p, _, _, _, _, beta] = &mut prim;
+        let [ux, uy, uz, p, _, _, _, _, beta, bz] = &mut prim;
         (passes.0)(
             &f.input(),
             &f.q,
@@ -101,13 +101,14 @@ fn run(f: &mut Fields, passes: Passes) -> Vec<u64> {
             &mut uy[r.clone()],
             &mut uz[r.clone()],
             &mut p[r.clone()],
-            &mut beta[r],
+            &mut beta[r.clone()],
+            &mut bz[r],
         );
     }
     f.prim = prim.clone();
     for k in 0..nz {
         let r = k * per..(k + 1) * per;
-        let [_, _, _, _, div, gx, gy, gz, _] = &mut prim;
+        let [_, _, _, _, div, gx, gy, gz, _, _] = &mut prim;
         (passes.1)(&f.input(), &f.view(), k, &mut div[r.clone()], &mut gx[r.clone()], &mut gy[r.clone()], &mut gz[r]);
     }
     f.prim = prim;
@@ -139,7 +140,7 @@ fn every_code_path_gives_the_same_bits() {
         macro_rules! on_path {
             ($path:ident) => {
                 (
-                    |a, b, c, d, e, f, g, h| unsafe { primitives_paths::$path(a, b, c, d, e, f, g, h) },
+                    |a, b, c, d, e, f, g, h, i| unsafe { primitives_paths::$path(a, b, c, d, e, f, g, h, i) },
                     |a, b, c, d, e, f, g| unsafe { gradients_paths::$path(a, b, c, d, e, f, g) },
                     |a, b, c, d, e, f| unsafe { axial_paths::$path(a, b, c, d, e, f) },
                     |a, b, c, d, e, f, g| unsafe { residual_paths::$path(a, b, c, d, e, f, g) },

@@ -691,11 +691,12 @@ impl GasSolver {
             pr.uz.par_chunks_mut(per),
             pr.p.par_chunks_mut(per),
             pr.beta.par_chunks_mut(per),
+            pr.beta_over_eps2.par_chunks_mut(per),
         )
             .into_par_iter()
             .with_min_len(rows)
             .enumerate()
-            .for_each(|(k, (ux, uy, uz, p, b))| primitives_layer(&inp, q, k, ux, uy, uz, p, b));
+            .for_each(|(k, (ux, uy, uz, p, b, bz))| primitives_layer(&inp, q, k, ux, uy, uz, p, b, bz));
         let (mut div, mut gx, mut gy, mut gz) = (
             std::mem::take(&mut pr.div),
             std::mem::take(&mut pr.gx),

@@ -62,7 +62,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
     let StepState { q, face, q_old, face_old, rhs, rhs_face, prim, axial } = s;
     let team = rayon::current_num_threads();
     assert!(fits(nz, team), "{nz} layers for a team of {team}");
-    let pr = [&mut prim.ux, &mut prim.uy, &mut prim.uz, &mut prim.p, &mut prim.beta];
+    let pr = [&mut prim.ux, &mut prim.uy, &mut prim.uz, &mut prim.p, &mut prim.beta, &mut prim.beta_over_eps2];
     let gr = [&mut prim.div, &mut prim.gx, &mut prim.gy, &mut prim.gz];
     let rows = [q.len(), q_old.len(), rhs.len(), axial.len(), inp.eps.len(), inp.force.len()];
     assert!(rows.iter().all(|&r| r == n) && pr.iter().chain(&gr).all(|f| f.len() == n), "one row per cell");
@@ -70,7 +70,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
     assert!([face.len(), face_old.len(), rhs_face.len()].iter().all(|&r| r == nface), "one row per face");
     assert!(inp.weights.len() == inp.past.len() + 1 && inp.past.len() == inp.past_face.len());
     assert!(inp.past.iter().all(|f| f.len() == n) && inp.past_face.iter().all(|f| f.len() == nface));
-    let [ux, uy, uz, p, beta] = pr.map(|f| Raw::new(f));
+    let [ux, uy, uz, p, beta, bz] = pr.map(|f| Raw::new(f));
     let [div, gx, gy, gz] = gr.map(|f| Raw::new(f));
     // The axial faces of the top layer are never written by the passes.
     rhs_face[(nz - 1) * per..n].fill(0.0);
@@ -100,13 +100,13 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                 fo.copy_from_slice(fs);
                 let (fs, fo) = unsafe { (face.view(f0, f1), face_old.part(f0, f1)) };
                 fo.copy_from_slice(fs);
-                let [wx, wy, wz, wp, wb] = unsafe { [ux, uy, uz, p, beta].map(|f| f.part(c0, c1)) };
+                let [wx, wy, wz, wp, wb, wbz] = unsafe { [ux, uy, uz, p, beta, bz].map(|f| f.part(c0, c1)) };
                 let rhs_in = unsafe { rhs_input(inp, face.view(0, nface)) };
                 let qv = unsafe { q.view(0, n) };
                 for k in k0..k1 {
                     let r = layer(k);
                     let (a, b, c, d) = (&mut wx[r.clone()], &mut wy[r.clone()], &mut wz[r.clone()], &mut wp[r.clone()]);
-                    primitives_layer(&rhs_in, qv, k, a, b, c, d, &mut wb[r]);
+                    primitives_layer(&rhs_in, qv, k, a, b, c, d, &mut wb[r.clone()], &mut wbz[r]);
                 }
             }
             if !barrier.wait() {
@@ -120,6 +120,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                         uz: uz.view(0, n),
                         p: p.view(0, n),
                         beta: beta.view(0, n),
+                        beta_over_eps2: bz.view(0, n),
                         div: &[],
                         gx: &[],
                         gy: &[],
@@ -138,7 +139,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                 return;
             }
             {
-                let v = unsafe { full_view([ux, uy, uz, p, beta, div, gx, gy, gz], n) };
+                let v = unsafe { full_view([ux, uy, uz, p, beta, bz, div, gx, gy, gz], n) };
                 let (rhs_in, qv) = unsafe { (rhs_input(inp, face.view(0, nface)), q.view(0, n)) };
                 // The axial faces above the own layers (none above the top layer).
                 let ka = k1.min(nz - 1);
@@ -153,7 +154,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                 return;
             }
             {
-                let v = unsafe { full_view([ux, uy, uz, p, beta, div, gx, gy, gz], n) };
+                let v = unsafe { full_view([ux, uy, uz, p, beta, bz, div, gx, gy, gz], n) };
                 let (rhs_in, qv) = unsafe { (rhs_input(inp, face.view(0, nface)), q.view(0, n)) };
                 let ax = unsafe { axial.view(0, n) };
                 let (wo, wf) = unsafe { (rhs.part(c0, c1), rhs_face.part(f0, f1)) };
@@ -213,7 +214,7 @@ fn rhs_input<'a>(inp: &StepInput<'a>, face_flux: &'a [f64]) -> RhsInput<'a> {
 
 /// # Safety
 /// No thread writes any of the fields while the view is live.
-unsafe fn full_view<'a>(f: [Raw<f64>; 9], n: usize) -> PrimView<'a> {
-    let [ux, uy, uz, p, beta, div, gx, gy, gz] = f.map(|r| r.view(0, n));
-    PrimView { ux, uy, uz, p, beta, div, gx, gy, gz }
+unsafe fn full_view<'a>(f: [Raw<f64>; 10], n: usize) -> PrimView<'a> {
+    let [ux, uy, uz, p, beta, beta_over_eps2, div, gx, gy, gz] = f.map(|r| r.view(0, n));
+    PrimView { ux, uy, uz, p, beta, beta_over_eps2, div, gx, gy, gz }
 }
