@@ -154,7 +154,8 @@ pub fn run() {
     let dt = case.dem.time_step_s;
     let plan = default.plan();
     let share = |t: &Tally| 1.0 - ta.per_step() / t.per_step();
-    for (name, t) in [("dem_alone", &ta), ("default", &td), ("paper", &tp), ("extrapolated_interval_20", &tl)] {
+    let long_name = format!("extrapolated_interval_{LONG_INTERVAL}");
+    for (name, t) in [("dem_alone", &ta), ("default", &td), ("paper", &tp), (long_name.as_str(), &tl)] {
         println!(
             "{}",
             json!({"bench": "coupled_mode", "mode": name, "s_per_step": t.per_step(), "share": share(t),

@@ -76,8 +76,8 @@ pub struct GasSolver {
     pressure_offset: f64,
     /// The mass budget of the flux-updated cells (mass_budget.rs); checkpointed beside the state.
     budget: MassBudget,
-    /// The gas's voidage between couplings when interpolated (voidage_ramp.rs); checkpointed
-    /// beside the state.
+    /// The gas's voidage between couplings when interpolated or extrapolated (voidage_ramp.rs);
+    /// checkpointed beside the state.
     ramp: Option<VoidageRamp>,
     /// Per cell (p, β/ε², εu) for `exchange_fields`, which reads each cell's several times.
     face_inputs: Vec<FaceInputs>,
