@@ -3,7 +3,7 @@
 //! to erupt at the top of the bed"). The paper's bed (50 mm, 110 mm settled, ≈ 150k particles for
 //! several seconds) does not fit a session on 2 cores, so this reads beds that do:
 //! - the 44-mm bubbling bed at 0.6 m/s (the run of `bubbling`, 2 simulated s);
-//! - the 22-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
+//! - the 44-mm, 90-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
 //!   paper's 0.563 m/s), where their runs have finished (this never starts them).
 //!
 //! Each run's analysis (accumulated while it ran) gives ΔP's dominant frequency, the eruptions at
@@ -48,9 +48,9 @@ pub fn run() -> Value {
         match crate::slug_rise::finished_at(u) {
             Some(done) => {
                 let p = point(
-                    &format!("22-mm bed, 90 mm settled, U = {u} m/s"),
+                    &format!("44-mm bed, 90 mm settled, U = {u} m/s"),
                     &done.analysis,
-                    &format!("docs/img/pressure_oscillation_22mm_U{u}.png"),
+                    &format!("docs/img/pressure_oscillation_slug44_U{u}.png"),
                 );
                 println!("{p}");
                 slugging.push(p);
@@ -65,6 +65,6 @@ pub fn run() -> Value {
     } else {
         let figure = ratios.iter().sum::<f64>() / ratios.len() as f64;
         json!({"name": "pressure-oscillation", "figure": figure, "reference": PAPER_CYCLES_PER_ERUPTION,
-            "rel_err": figure / PAPER_CYCLES_PER_ERUPTION - 1.0, "bed": "22-mm slugging beds at 0.54 and 0.60 m/s"})
+            "rel_err": figure / PAPER_CYCLES_PER_ERUPTION - 1.0, "bed": "44-mm slugging beds at 0.54 and 0.60 m/s"})
     }
 }
