@@ -167,26 +167,23 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     // Upwind-upwind layers of an upward and a downward face; at the ends the upwind layer itself,
     // for which SMART gives φ_C: first-order upwind.
     let (below, above) = (if k >= 1 { k - 1 } else { k }, if k + 2 < nz { k + 2 } else { k + 1 });
-    let two = |f| (layer(f, per, lo), layer(f, per, hi));
+    let two = |f| (&layer(f, per, lo)[..per], &layer(f, per, hi)[..per]);
     let ((eps_lo, eps_hi), (p_lo, p_hi)) = (two(inp.eps), two(pr.p));
     let ((gz_lo, gz_hi), (b_lo, b_hi), (d_lo, d_hi)) = (two(pr.gz), two(pr.beta), two(pr.div));
-    let (q_lo, q_hi) = (&q[lo * per..(lo + 1) * per], &q[hi * per..(hi + 1) * per]);
-    let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)];
+    let (q_lo, q_hi) = (&q[lo * per..(lo + 1) * per][..per], &q[hi * per..(hi + 1) * per][..per]);
+    let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)].map(|l| &l[..per]);
     let (vx, vy, vz) = (four(pr.ux), four(pr.uy), four(pr.uz));
-    let ff = &inp.face_flux[lo * per..(lo + 1) * per];
-    // ρεu_z of the four layers for the momentum dissipation; beyond the ends the linear ghosts
-    // 2m_in − m_0 (inlet flux ρ_f U) and 2m_top − m_below.
-    let mz = |k: usize, c: usize| q[k * per + c][3];
-    let ghost_below = |c: usize| {
-        if k >= 1 {
-            mz(k - 1, c)
-        } else {
-            2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - mz(0, c)
-        }
-    };
-    let ghost_above = |c: usize| if k + 2 < nz { mz(k + 2, c) } else { 2.0 * mz(k + 1, c) - mz(k, c) };
+    let ff = &inp.face_flux[lo * per..(lo + 1) * per][..per];
     let km = MOMENTUM_DISSIPATION * par.sound_speed;
     let (out, out_fz) = (&mut out[..per], &mut out_fz[..per]);
+    // ρεu_z of the layers below lo and above hi for the momentum dissipation, parked in the first
+    // two slots of each face's output row (overwritten below); beyond the ends the linear ghosts
+    // 2m_in − m_0 (inlet flux ρ_f U) and 2m_top − m_below. A separate loop keeps the inlet's
+    // function calls out of the main loop, which then has no calls or branches.
+    for (c, o) in out.iter_mut().enumerate() {
+        o[0] = if k >= 1 { q[(k - 1) * per + c][3] } else { 2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - q_lo[c][3] };
+        o[1] = if k + 2 < nz { q[(k + 2) * per + c][3] } else { 2.0 * q_hi[c][3] - q_lo[c][3] };
+    }
     let (az, a, dz) = (geo.area_z, par.sound_speed, inp.dz);
     let kd = PRESSURE_DISSIPATION / par.sound_speed;
     // The face into the characteristic outlet layer carries no correction: that layer follows
@@ -195,6 +192,7 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     let m = par.viscosity * az / dz;
     let lam_coef = par.bulk_viscosity + par.viscosity / 3.0;
     for c in 0..per {
+        let (ghost_below, ghost_above) = (out[c][0], out[c][1]);
         let eps_f = 0.5 * (eps_lo[c] + eps_hi[c]);
         let mismatch = (p_hi[c] - p_lo[c]) - 0.5 * (gz_lo[c] + gz_hi[c]) * dz;
         let diss = kd * eps_f * az * mismatch;
@@ -207,7 +205,7 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
         let (fx, fy, fz) = (upwind_face(up, &vx, c), upwind_face(up, &vy, c), upwind_face(up, &vz, c));
         let lam = lam_coef * 0.5 * (d_lo[c] + d_hi[c]) * az;
         // Momentum mismatch (m_hi − m_lo) − ½(∇m_lo + ∇m_hi)·dz = −¼ × the third difference.
-        let mis_m = -0.25 * (ghost_above(c) - 3.0 * q_hi[c][3] + 3.0 * q_lo[c][3] - ghost_below(c));
+        let mis_m = -0.25 * (ghost_above - 3.0 * q_hi[c][3] + 3.0 * q_lo[c][3] - ghost_below);
         out[c] = [
             mflux,
             mflux * fx,
