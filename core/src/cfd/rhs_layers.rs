@@ -80,12 +80,14 @@ fn gradients_body(
 ) {
     let (per, nz, geo, par) = (inp.per, inp.nz, inp.geo, inp.params);
     let a2 = par.sound_speed * par.sound_speed;
-    let (ux, uy, uz, p) = (layer(pr.ux, per, k), layer(pr.uy, per, k), layer(pr.uz, per, k), layer(pr.p, per, k));
+    let l = |f, k| &layer(f, per, k)[..per];
+    let (ux, uy, uz, p) = (l(pr.ux, k), l(pr.uy, k), l(pr.uz, k), l(pr.p, k));
     let (div, gx, gy, gz) = (&mut div[..per], &mut gx[..per], &mut gy[..per], &mut gz[..per]);
-    // β/ε² per cell (`drag_weighted_face_pressure`) and ε per cell of this layer.
-    let bz = |k: usize, c: usize| pr.beta_over_eps2[k * per + c];
-    let (eps, eps_b, eps_a) =
-        (layer(inp.eps, per, k), layer(inp.eps, per, k.max(1) - 1), layer(inp.eps, per, (k + 1).min(nz - 1)));
+    // β/ε² (`drag_weighted_face_pressure`) and ε per cell of this layer and the layers below and
+    // above (this layer's at the column's ends, where they are not read).
+    let (kb, ka) = (k.max(1) - 1, (k + 1).min(nz - 1));
+    let (bz_b, bz_k, bz_a) = (l(pr.beta_over_eps2, kb), l(pr.beta_over_eps2, k), l(pr.beta_over_eps2, ka));
+    let (eps, eps_b, eps_a) = (l(inp.eps, k), l(inp.eps, kb), l(inp.eps, ka));
     div.fill(0.0);
     gx.fill(0.0);
     gy.fill(0.0);
@@ -98,7 +100,7 @@ fn gradients_body(
         // (p_f − p_c)·S_out with p_f = ½(p_a + p_b) + w: ½(p_b − p_a) + w for a, ½(p_b − p_a) − w for b.
         let dp = 0.5 * (p[b] - p[a]);
         let j = 0.5 * ((eps[a] * ux[a] + eps[b] * ux[b]) * f.dx + (eps[a] * uy[a] + eps[b] * uy[b]) * f.dy);
-        let w = drag_weighted_face_pressure(bz(k, a), bz(k, b), j);
+        let w = drag_weighted_face_pressure(bz_k[a], bz_k[b], j);
         gx[a] += (dp + w) * f.sx;
         gy[a] += (dp + w) * f.sy;
         gx[b] += (dp - w) * f.sx;
@@ -107,8 +109,8 @@ fn gradients_body(
     let (w_in, _) = inp.inlet();
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
     let jz = |lo: f64, hi: f64| 0.5 * (lo + hi) * inp.dz;
-    let below = (k > 0).then(|| (layer(pr.uz, per, k - 1), layer(pr.p, per, k - 1)));
-    let above = (k + 1 < nz).then(|| (layer(pr.uz, per, k + 1), layer(pr.p, per, k + 1)));
+    let below = (k > 0).then(|| (l(pr.uz, k - 1), l(pr.p, k - 1)));
+    let above = (k + 1 < nz).then(|| (l(pr.uz, k + 1), l(pr.p, k + 1)));
     // Face values (w, p) below and above each cell.
     let inlet = |c: usize| (w_in, inlet_face_pressure(p[c], above.map(|(_, pa)| pa[c]), par.gravity, inp.dz, a2));
     let top = |c: usize| {
@@ -130,8 +132,8 @@ fn gradients_body(
             for c in 0..per {
                 let (w_bot, w_top) = (0.5 * (uzb[c] + uz[c]), 0.5 * (uz[c] + uza[c]));
                 let (j_bot, j_top) = (jz(eps_b[c] * uzb[c], eps[c] * uz[c]), jz(eps[c] * uz[c], eps_a[c] * uza[c]));
-                let p_bot = 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz(k - 1, c), bz(k, c), j_bot);
-                let p_top = 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz(k, c), bz(k + 1, c), j_top);
+                let p_bot = 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz_b[c], bz_k[c], j_bot);
+                let p_top = 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz_k[c], bz_a[c], j_top);
                 div[c] = (div[c] + (w_top - w_bot) * az) * inv_v;
                 gz[c] = (p_top - p_bot) * az * inv_v;
             }
@@ -139,14 +141,14 @@ fn gradients_body(
         (Some((uzb, pb)), None) => {
             let bot = |c: usize| {
                 let j = jz(eps_b[c] * uzb[c], eps[c] * uz[c]);
-                (0.5 * (uzb[c] + uz[c]), 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz(k - 1, c), bz(k, c), j))
+                (0.5 * (uzb[c] + uz[c]), 0.5 * (pb[c] + p[c]) + drag_weighted_face_pressure(bz_b[c], bz_k[c], j))
             };
             close(&bot, &top, div, gz)
         }
         (None, Some((uza, pa))) => {
             let up = |c: usize| {
                 let j = jz(eps[c] * uz[c], eps_a[c] * uza[c]);
-                (0.5 * (uz[c] + uza[c]), 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz(k, c), bz(k + 1, c), j))
+                (0.5 * (uz[c] + uza[c]), 0.5 * (p[c] + pa[c]) + drag_weighted_face_pressure(bz_k[c], bz_a[c], j))
             };
             close(&inlet, &up, div, gz)
         }
@@ -248,8 +250,8 @@ fn residual_body(
         out_fh.fill(0.0);
         return;
     }
-    let l = |f| layer(f, per, k);
-    let (eps, force, qk) = (l(inp.eps), &inp.force[k * per..(k + 1) * per], &q[k * per..(k + 1) * per]);
+    let l = |f| &layer(f, per, k)[..per];
+    let (eps, force, qk) = (l(inp.eps), &inp.force[k * per..(k + 1) * per][..per], &q[k * per..(k + 1) * per][..per]);
     let (ux, uy, uz, p, beta, div) = (l(pr.ux), l(pr.uy), l(pr.uz), l(pr.p), l(pr.beta), l(pr.div));
     let (gx, gy, gz) = (l(pr.gx), l(pr.gy), l(pr.gz));
     let (cos_c, sin_c) = (&geo.cos_c[..per], &geo.sin_c[..per]);
@@ -317,7 +319,7 @@ fn residual_body(
             r[3] += m_in * w_in * inv_v;
         }
     } else {
-        let below = &axial[(k - 1) * per..k * per];
+        let below = &axial[(k - 1) * per..k * per][..per];
         for c in 0..per {
             let (e, f, r) = (eps[c] * inv_v, &below[c], &mut out[c]);
             for n in 0..4 {
@@ -329,7 +331,7 @@ fn residual_body(
         }
     }
     if k + 1 < nz {
-        let above = &axial[k * per..(k + 1) * per];
+        let above = &axial[k * per..(k + 1) * per][..per];
         for c in 0..per {
             let (e, f, r) = (eps[c] * inv_v, &above[c], &mut out[c]);
             for n in 0..4 {
