@@ -10,4 +10,5 @@ pub mod dem;
 pub mod grid;
 pub mod output;
 pub mod sim;
+mod simd;
 mod team;

@@ -4,8 +4,7 @@
 //! per cell, the upwind choice of the axial faces as selects, and the horizontal faces computed in
 //! blocks into a stack buffer (gathers only) before they are scattered to their cells in face order.
 //! Each pass runs compiled for AVX-512 or AVX2 when the CPU has them and `FLUIDBED_KERNEL` allows
-//! (dem/kernel.rs); every path does the same IEEE operations in the same order, so all give the
-//! same bits (test `every_code_path_gives_the_same_bits`).
+//! (`simd::per_isa`); every path gives the same bits (test `every_code_path_gives_the_same_bits`).
 
 use super::geometry::HFace;
 use super::params::Outlet;
@@ -14,6 +13,7 @@ use super::rhs::{
     top_face_pressure, PrimView, RhsInput, MOMENTUM_DISSIPATION, PRESSURE_DISSIPATION,
 };
 use super::smart::smart_face;
+use crate::simd::per_isa;
 
 /// Horizontal faces per block of the residual pass (a stack buffer of 7 values each).
 const FACE_BLOCK: usize = 32;
@@ -173,7 +173,8 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     let ((eps_lo, eps_hi), (p_lo, p_hi)) = (two(inp.eps), two(pr.p));
     let ((gz_lo, gz_hi), (b_lo, b_hi), (d_lo, d_hi)) = (two(pr.gz), two(pr.beta), two(pr.div));
     let (q_lo, q_hi) = (&q[lo * per..(lo + 1) * per][..per], &q[hi * per..(hi + 1) * per][..per]);
-    let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)].map(|l| &l[..per]);
+    let four =
+        |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)].map(|l| &l[..per]);
     let (vx, vy, vz) = (four(pr.ux), four(pr.uy), four(pr.uz));
     let ff = &inp.face_flux[lo * per..(lo + 1) * per][..per];
     let km = MOMENTUM_DISSIPATION * par.sound_speed;
@@ -183,7 +184,11 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     // 2m_in − m_0 (inlet flux ρ_f U) and 2m_top − m_below. A separate loop keeps the inlet's
     // function calls out of the main loop, which then has no calls or branches.
     for (c, o) in out.iter_mut().enumerate() {
-        o[0] = if k >= 1 { q[(k - 1) * per + c][3] } else { 2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - q_lo[c][3] };
+        o[0] = if k >= 1 {
+            q[(k - 1) * per + c][3]
+        } else {
+            2.0 * inlet_mass_flux(inp, pr.p, c) / geo.area_z - q_lo[c][3]
+        };
         o[1] = if k + 2 < nz { q[(k + 2) * per + c][3] } else { 2.0 * q_hi[c][3] - q_lo[c][3] };
     }
     let (az, a, dz) = (geo.area_z, par.sound_speed, inp.dz);
@@ -344,99 +349,32 @@ fn residual_body(
     }
 }
 
-/// The public pass `$name` running `$body` on the best path the CPU and `FLUIDBED_KERNEL` allow,
-/// and `$name` compiled for each path (for the test that they agree).
-macro_rules! per_isa {
-    ($(#[$doc:meta])* $name:ident, $paths:ident, $body:ident, ($($arg:ident: $ty:ty),*)) => {
-        $(#[$doc])*
-        #[allow(clippy::too_many_arguments)]
-        pub fn $name($($arg: $ty),*) {
-            #[cfg(target_arch = "x86_64")]
-            match simd_path() {
-                // SAFETY: `simd_path` found the features each function is compiled for.
-                SimdPath::Avx512 => return unsafe { $paths::avx512($($arg),*) },
-                SimdPath::Avx2 => return unsafe { $paths::avx2($($arg),*) },
-                SimdPath::Portable => {}
-            }
-            $body($($arg),*)
-        }
-
-        #[cfg(target_arch = "x86_64")]
-        #[allow(clippy::too_many_arguments)]
-        mod $paths {
-            use super::*;
-            /// # Safety
-            /// The CPU has avx512f, avx512vl and avx512dq.
-            #[target_feature(enable = "avx512f,avx512vl,avx512dq")]
-            pub(super) unsafe fn avx512($($arg: $ty),*) {
-                $body($($arg),*)
-            }
-            /// # Safety
-            /// The CPU has avx2.
-            #[target_feature(enable = "avx2")]
-            pub(super) unsafe fn avx2($($arg: $ty),*) {
-                $body($($arg),*)
-            }
-        }
-    };
-}
-
 per_isa!(
     /// Fill the primitive fields of one layer from the state.
-    primitives_layer, primitives_paths, primitives_body,
+    pub fn primitives_layer, primitives_paths, primitives_body,
     (inp: &RhsInput, q: &[[f64; 4]], k: usize, ux: &mut [f64], uy: &mut [f64], uz: &mut [f64], p: &mut [f64], beta: &mut [f64], beta_over_eps2: &mut [f64])
 );
 per_isa!(
     /// ∇·u and ∇p of one layer's cells by Green–Gauss: (1/V) Σ φ_f S with face means; the tube
     /// wall takes the cell's own values (u·n = 0, p_f = p_c); the ends as in rhs.rs (the inlet
     /// face velocity U/ε_in, a shut top 0, the outlet zero-gradient).
-    gradients_layer, gradients_paths, gradients_body,
+    pub fn gradients_layer, gradients_paths, gradients_body,
     (inp: &RhsInput, pr: &PrimView, k: usize, div: &mut [f64], gx: &mut [f64], gy: &mut [f64], gz: &mut [f64])
 );
 per_isa!(
     /// The axial faces above the cells of layer k (k + 1 < nz), computed once for both layers they
     /// join: per face [ṁ, ṁu_x, ṁu_y, ṁu_z, viscous force on the lower cell (3)] into `out` and
     /// dF/dt into `out_fz` (one layer long).
-    axial_layer, axial_paths, axial_body,
+    pub fn axial_layer, axial_paths, axial_body,
     (inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut [[f64; 7]], out_fz: &mut [f64])
 );
 per_isa!(
     /// d q/dt of every cell of layer k (per unit volume) into `out` (one layer long), and dF/dt of
     /// the layer's horizontal face corrections into `out_fh`; `axial` holds the axial faces of
     /// `axial_layer` (the one below layer k at index k − 1, the one above at k).
-    residual_layer, residual_paths, residual_body,
+    pub fn residual_layer, residual_paths, residual_body,
     (inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, axial: &[[f64; 7]], k: usize, out: &mut [[f64; 4]], out_fh: &mut [f64])
 );
-
-/// The code path of the passes.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-enum SimdPath {
-    Portable,
-    Avx2,
-    Avx512,
-}
-
-/// The best path this CPU has within the one `FLUIDBED_KERNEL` asks for (once per process).
-#[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-fn simd_path() -> SimdPath {
-    static PATH: std::sync::OnceLock<SimdPath> = std::sync::OnceLock::new();
-    *PATH.get_or_init(|| {
-        #[cfg(target_arch = "x86_64")]
-        {
-            use crate::dem::Kernel;
-            use std::arch::is_x86_feature_detected as has;
-            let kernel = Kernel::from_env();
-            if kernel == Kernel::Avx512 && has!("avx512f") && has!("avx512vl") && has!("avx512dq") {
-                return SimdPath::Avx512;
-            }
-            if kernel != Kernel::Portable && has!("avx2") {
-                return SimdPath::Avx2;
-            }
-        }
-        SimdPath::Portable
-    })
-}
 
 #[cfg(test)]
 #[path = "rhs_layers_tests.rs"]

@@ -21,6 +21,7 @@ use super::drag::beetstra_f;
 use super::drag::{clamp_voidage, drag_force, Beetstra, DiFelice, DragLaw, DragModel, Gidaspow};
 use super::sublayer_pressure::{add_sublayer_pressure, SubLayerDrag};
 use crate::grid::CylGrid;
+use crate::simd::per_isa;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 
@@ -366,71 +367,12 @@ impl Exchange {
     }
 }
 
-/// `particle_block_pass` compiled for the best vector extension the CPU has (and
-/// `FLUIDBED_KERNEL` allows): the same operations in the same order, so the same bits.
-#[allow(clippy::too_many_arguments)]
-fn particle_block_pass_on<L: DragLaw>(
-    grid: &CylGrid,
-    table: &[CellTable<L::Cell>],
-    vp: f64,
-    pos: &[[f64; 3]],
-    vel: &[[f64; 3]],
-    force: &mut [[f64; 3]],
-    cell_of: &mut [u32],
-    gas_sum: &mut [[f64; 3]],
-) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use crate::dem::Kernel;
-        use std::arch::is_x86_feature_detected as has;
-        let kernel = Kernel::from_env();
-        if kernel == Kernel::Avx512 && has!("avx512f") && has!("avx512vl") && has!("avx512dq") {
-            // SAFETY: the CPU has the features the function is compiled for.
-            return unsafe { particle_block_pass_avx512::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum) };
-        }
-        if kernel != Kernel::Portable && has!("avx2") {
-            // SAFETY: as above.
-            return unsafe { particle_block_pass_avx2::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum) };
-        }
-    }
-    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
-}
-
-/// # Safety
-/// The CPU has avx512f, avx512vl and avx512dq.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx512vl,avx512dq")]
-#[allow(clippy::too_many_arguments)]
-unsafe fn particle_block_pass_avx512<L: DragLaw>(
-    grid: &CylGrid,
-    table: &[CellTable<L::Cell>],
-    vp: f64,
-    pos: &[[f64; 3]],
-    vel: &[[f64; 3]],
-    force: &mut [[f64; 3]],
-    cell_of: &mut [u32],
-    gas_sum: &mut [[f64; 3]],
-) {
-    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
-}
-
-/// # Safety
-/// The CPU has avx2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-#[allow(clippy::too_many_arguments)]
-unsafe fn particle_block_pass_avx2<L: DragLaw>(
-    grid: &CylGrid,
-    table: &[CellTable<L::Cell>],
-    vp: f64,
-    pos: &[[f64; 3]],
-    vel: &[[f64; 3]],
-    force: &mut [[f64; 3]],
-    cell_of: &mut [u32],
-    gas_sum: &mut [[f64; 3]],
-) {
-    particle_block_pass::<L>(grid, table, vp, pos, vel, force, cell_of, gas_sum)
-}
+per_isa!(
+    /// `particle_block_pass` on the best vector path the CPU has (`simd::per_isa`): the same
+    /// operations in the same order, so the same bits.
+    fn particle_block_pass_on<L: DragLaw>, particle_pass_paths, particle_block_pass,
+    (grid: &CylGrid, table: &[CellTable<L::Cell>], vp: f64, pos: &[[f64; 3]], vel: &[[f64; 3]], force: &mut [[f64; 3]], cell_of: &mut [u32], gas_sum: &mut [[f64; 3]])
+);
 
 /// One chunk of the particle pass, in blocks of `BLOCK` particles: the cell and the gas state
 /// per particle (scalar), the drag law's F over the block (branch-free, vectorisable), then the

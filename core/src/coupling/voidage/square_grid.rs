@@ -8,6 +8,7 @@ use super::sphere_box::sphere_box_volume;
 use super::{Scatter, VoidageMethod};
 use crate::case::BoxSplit;
 use crate::grid::CylGrid;
+use crate::simd::per_isa;
 use std::f64::consts::PI;
 
 pub struct SquareGrid {
@@ -160,34 +161,12 @@ fn two_stage_cuboid(
     });
 }
 
-/// `deposit_small_cubes` compiled for AVX2 when the CPU has it and `FLUIDBED_KERNEL` allows: the
-/// same operations in the same order (no fused multiply-add), so the same bits.
-fn deposit_small_cubes_on(positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64]) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use crate::dem::Kernel;
-        if Kernel::from_env() != Kernel::Portable && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the CPU has the feature the function is compiled for.
-            return unsafe { deposit_small_cubes_avx2(positions, across, up, nb, vp, buf) };
-        }
-    }
-    deposit_small_cubes(positions, across, up, nb, vp, buf)
-}
-
-/// # Safety
-/// The CPU has avx2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn deposit_small_cubes_avx2(
-    positions: &[[f64; 3]],
-    across: SplitTwo,
-    up: SplitTwo,
-    nb: usize,
-    vp: f64,
-    buf: &mut [f64],
-) {
-    deposit_small_cubes(positions, across, up, nb, vp, buf)
-}
+per_isa!(
+    /// `deposit_small_cubes` on the best vector path the CPU has (`simd::per_isa`): the same
+    /// operations in the same order (no fused multiply-add), so the same bits.
+    fn deposit_small_cubes_on, deposit_paths, deposit_small_cubes,
+    (positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64])
+);
 
 /// Each particle's cube (side h ≤ the box side and the layer height) onto its 2 × 2 × 2 boxes of
 /// `buf` (layer-major, rows of `nb` boxes): per layer and row the two boxes are neighbours.
