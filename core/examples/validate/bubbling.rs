@@ -119,14 +119,7 @@ pub fn run_to(end_s: f64) -> RunSummary {
             }
             let ms = (s.time_s * 1000.0).round() as i64;
             if (700..=1000).contains(&ms) && ms % 50 == 0 {
-                crate::plots::slice(
-                    &s,
-                    eps,
-                    "voidage ε [-]",
-                    0.35,
-                    1.0,
-                    &format!("docs/img/bubbling_voidage_{ms:04}ms.png"),
-                );
+                crate::plots::voidage_slice(&s, eps, &format!("docs/img/bubbling_voidage_{ms:04}ms.png"));
             }
             if s.index % 10 == 0 {
                 p.wall_s = wall_before + t0.elapsed().as_secs_f64();

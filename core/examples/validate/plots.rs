@@ -56,3 +56,8 @@ pub fn slice(s: &Snapshot, field: &[f64], quantity: &str, lo: f64, hi: f64, path
     let title = format!("t = {:.4} s", s.time_s);
     save(plot::axial_slice(&s.grid.grid(), field, &FieldLabels { title: &title, quantity, lo, hi }), path);
 }
+
+/// The voidage on the axial plane of a snapshot, on the colour range of the bed pictures (0.35–1).
+pub fn voidage_slice(s: &Snapshot, eps: &[f64], path: &str) {
+    slice(s, eps, "voidage ε [-]", 0.35, 1.0, path);
+}

@@ -117,14 +117,7 @@ fn run_at(u: f64) -> Finished {
         let ms = (s.time_s * 1000.0).round() as i64;
         if ms > (END_S * 1000.0) as i64 - 60 && ms % 20 == 0 {
             let eps = s.voidage.as_ref().expect("voidage field");
-            crate::plots::slice(
-                &s,
-                eps,
-                "voidage ε [-]",
-                0.35,
-                1.0,
-                &format!("docs/img/slug_rise_44mm_U{u}_{ms:04}ms.png"),
-            );
+            crate::plots::voidage_slice(&s, eps, &format!("docs/img/slug_rise_44mm_U{u}_{ms:04}ms.png"));
         }
         if s.index % 5 == 0 {
             let wall = wall_before + t0.elapsed().as_secs_f64();
