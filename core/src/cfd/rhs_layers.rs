@@ -18,10 +18,11 @@ use crate::simd::per_isa;
 /// Horizontal faces per block of the residual pass (a stack buffer of 7 values each).
 const FACE_BLOCK: usize = 32;
 
-/// One layer of a cell field.
+/// One layer of a cell field (or of a per-cell row array), cut so that its length is `per` to the
+/// compiler: the loops over the layer's cells then carry no bounds checks and vectorise.
 #[inline(always)]
-fn layer(f: &[f64], per: usize, k: usize) -> &[f64] {
-    &f[k * per..(k + 1) * per]
+fn layer<T>(f: &[T], per: usize, k: usize) -> &[T] {
+    &f[k * per..(k + 1) * per][..per]
 }
 
 /// The in-layer cells of a face, clamped to the layer: a no-op for a grid's faces (each joins two
@@ -49,8 +50,7 @@ fn primitives_body(
 ) {
     let per = inp.per;
     let a2 = inp.params.sound_speed * inp.params.sound_speed;
-    let r = k * per..(k + 1) * per;
-    let (q, eps, force) = (&q[r.clone()], &inp.eps[r.clone()], &inp.force[r]);
+    let (q, eps, force) = (layer(q, per, k), layer(inp.eps, per, k), layer(inp.force, per, k));
     let (ux, uy, uz, p, beta) = (&mut ux[..per], &mut uy[..per], &mut uz[..per], &mut p[..per], &mut beta[..per]);
     let beta_over_eps2 = &mut beta_over_eps2[..per];
     for c in 0..per {
@@ -80,7 +80,7 @@ fn gradients_body(
 ) {
     let (per, nz, geo, par) = (inp.per, inp.nz, inp.geo, inp.params);
     let a2 = par.sound_speed * par.sound_speed;
-    let l = |f, k| &layer(f, per, k)[..per];
+    let l = |f, k| layer(f, per, k);
     let (ux, uy, uz, p) = (l(pr.ux, k), l(pr.uy, k), l(pr.uz, k), l(pr.p, k));
     let (div, gx, gy, gz) = (&mut div[..per], &mut gx[..per], &mut gy[..per], &mut gz[..per]);
     // β/ε² (`drag_weighted_face_pressure`) and ε per cell of this layer and the layers below and
@@ -169,14 +169,13 @@ fn axial_body(inp: &RhsInput, q: &[[f64; 4]], pr: &PrimView, k: usize, out: &mut
     // Upwind-upwind layers of an upward and a downward face; at the ends the upwind layer itself,
     // for which SMART gives φ_C: first-order upwind.
     let (below, above) = (if k >= 1 { k - 1 } else { k }, if k + 2 < nz { k + 2 } else { k + 1 });
-    let two = |f| (&layer(f, per, lo)[..per], &layer(f, per, hi)[..per]);
+    let two = |f| (layer(f, per, lo), layer(f, per, hi));
     let ((eps_lo, eps_hi), (p_lo, p_hi)) = (two(inp.eps), two(pr.p));
     let ((gz_lo, gz_hi), (b_lo, b_hi), (d_lo, d_hi)) = (two(pr.gz), two(pr.beta), two(pr.div));
-    let (q_lo, q_hi) = (&q[lo * per..(lo + 1) * per][..per], &q[hi * per..(hi + 1) * per][..per]);
-    let four =
-        |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)].map(|l| &l[..per]);
+    let (q_lo, q_hi) = (layer(q, per, lo), layer(q, per, hi));
+    let four = |f| [layer(f, per, below), layer(f, per, lo), layer(f, per, hi), layer(f, per, above)];
     let (vx, vy, vz) = (four(pr.ux), four(pr.uy), four(pr.uz));
-    let ff = &inp.face_flux[lo * per..(lo + 1) * per][..per];
+    let ff = layer(inp.face_flux, per, lo);
     let km = MOMENTUM_DISSIPATION * par.sound_speed;
     let (out, out_fz) = (&mut out[..per], &mut out_fz[..per]);
     // ρεu_z of the layers below lo and above hi for the momentum dissipation, parked in the first
@@ -255,8 +254,8 @@ fn residual_body(
         out_fh.fill(0.0);
         return;
     }
-    let l = |f| &layer(f, per, k)[..per];
-    let (eps, force, qk) = (l(inp.eps), &inp.force[k * per..(k + 1) * per][..per], &q[k * per..(k + 1) * per][..per]);
+    let l = |f| layer(f, per, k);
+    let (eps, force, qk) = (l(inp.eps), layer(inp.force, per, k), layer(q, per, k));
     let (ux, uy, uz, p, beta, div) = (l(pr.ux), l(pr.uy), l(pr.uz), l(pr.p), l(pr.beta), l(pr.div));
     let (gx, gy, gz) = (l(pr.gx), l(pr.gy), l(pr.gz));
     let (cos_c, sin_c) = (&geo.cos_c[..per], &geo.sin_c[..per]);
@@ -324,7 +323,7 @@ fn residual_body(
             r[3] += m_in * w_in * inv_v;
         }
     } else {
-        let below = &axial[(k - 1) * per..k * per][..per];
+        let below = layer(axial, per, k - 1);
         for c in 0..per {
             let (e, f, r) = (eps[c] * inv_v, &below[c], &mut out[c]);
             for n in 0..4 {
@@ -336,7 +335,7 @@ fn residual_body(
         }
     }
     if k + 1 < nz {
-        let above = &axial[k * per..(k + 1) * per][..per];
+        let above = layer(axial, per, k);
         for c in 0..per {
             let (e, f, r) = (eps[c] * inv_v, &above[c], &mut out[c]);
             for n in 0..4 {
