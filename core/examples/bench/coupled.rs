@@ -181,16 +181,23 @@ pub fn parts() {
     let (grid, dem, gas) = (sim.grid(), sim.dem(), sim.gas().expect("gas"));
     let n = grid.num_cells();
     let reps = 200;
+    // Mean and median per call: on a shared machine the median is the steadier figure.
     let time = |label: &str, f: &mut dyn FnMut()| {
         f();
-        let t0 = Instant::now();
-        for _ in 0..reps {
-            f();
-        }
-        let ms = t0.elapsed().as_secs_f64() * 1e3 / reps as f64;
+        let mut calls: Vec<f64> = (0..reps)
+            .map(|_| {
+                let t0 = Instant::now();
+                f();
+                t0.elapsed().as_secs_f64() * 1e3
+            })
+            .collect();
+        let ms = calls.iter().sum::<f64>() / reps as f64;
+        calls.sort_by(f64::total_cmp);
+        let median = calls[reps / 2];
         println!(
             "{}",
-            json!({"bench": "coupled_part", "part": label, "ms_per_call": ms, "ns_per_particle": ms * 1e6 / dem.len() as f64})
+            json!({"bench": "coupled_part", "part": label, "ms_per_call": ms, "median_ms_per_call": median,
+                   "ns_per_particle": ms * 1e6 / dem.len() as f64, "median_ns_per_particle": median * 1e6 / dem.len() as f64})
         );
     };
     let mut method = build_voidage(&case, grid);
