@@ -11,7 +11,7 @@ use serde_json::json;
 use std::path::PathBuf;
 use std::time::Instant;
 
-const FLUIDIZED_AT_S: f64 = 0.3;
+pub const FLUIDIZED_AT_S: f64 = 0.3;
 const STEPS: u64 = 2000;
 const ROUND: u64 = 250;
 /// The coupling interval of the extra mode (with the gas's voidage extrapolated).

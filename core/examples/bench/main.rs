@@ -1,6 +1,7 @@
 //! Benchmarks: `cargo run --release -p fluidbed-core --example bench -- <dem|cfd|voidage|coupled|scaling|halo|…>`.
 //! Each prints JSON lines; the last line of each is the figure the issues quote.
 
+mod adaptive;
 mod cfd;
 mod coupled;
 mod dem;
@@ -21,6 +22,7 @@ fn main() {
 
 fn run(what: &str) {
     match what {
+        "adaptive-step" => adaptive::run(),
         "cfd" => cfd::run(),
         "coupled" => coupled::run(),
         "coupled-parts" => coupled::parts(),
