@@ -29,9 +29,9 @@ struct Args {
     /// Jobs run at once (0 runs none: jobs are accepted and wait in the queue).
     #[arg(long, default_value_t = 1)]
     workers: usize,
-    /// Threads of each job's rayon pool.
-    #[arg(long, default_value_t = default_threads())]
-    threads_per_job: usize,
+    /// Threads of each job's rayon pool (default: the cores shared among the workers).
+    #[arg(long)]
+    threads_per_job: Option<usize>,
     /// Largest accepted case, in bytes.
     #[arg(long, default_value_t = 16 << 20)]
     max_body_bytes: usize,
@@ -106,14 +106,31 @@ fn parse_lease(s: &str) -> Result<f64, String> {
     }
 }
 
-fn default_threads() -> usize {
+fn cores() -> usize {
     std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+}
+
+/// Threads per job: as asked, or the cores shared evenly among the jobs that run at once (a
+/// job's threads step as one team; two coupled jobs of 2 threads each on 2 cores took 12–20% longer
+/// per step than two of 1 thread, docs/BENCHMARKS.md "Jobs side by side").
+fn threads_per_job(asked: Option<usize>, workers: usize, cores: usize) -> usize {
+    asked.unwrap_or(cores / workers.max(1)).max(1)
 }
 
 /// Parse the flags, serve, stop cleanly on SIGINT or SIGTERM.
 pub fn main() -> anyhow::Result<()> {
     let a = Args::parse();
     init_logs(a.log_format);
+    let threads_per_job = threads_per_job(a.threads_per_job, a.workers, cores());
+    if a.workers * threads_per_job > cores() {
+        tracing::warn!(
+            workers = a.workers,
+            threads_per_job,
+            cores = cores(),
+            "more job threads than cores: concurrent jobs will contend (--threads-per-job {} would not)",
+            (cores() / a.workers.max(1)).max(1)
+        );
+    }
     let cfg = Config {
         data_dir: a.data_dir,
         database: a.database.filter(|d| !d.is_empty()),
@@ -121,7 +138,7 @@ pub fn main() -> anyhow::Result<()> {
         listen: a.listen,
         token: a.token.filter(|t| !t.is_empty()),
         workers: a.workers,
-        threads_per_job: a.threads_per_job,
+        threads_per_job,
         max_body_bytes: a.max_body_bytes,
         max_queued: a.max_queued,
         submissions_per_s: a.submissions_per_s,
@@ -154,4 +171,20 @@ pub fn main() -> anyhow::Result<()> {
     tracing::info!("stopping; running jobs resume from their checkpoints at the next start");
     server.shutdown();
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::threads_per_job;
+
+    #[test]
+    fn the_cores_are_shared_among_the_workers_unless_asked() {
+        assert_eq!(threads_per_job(None, 1, 8), 8);
+        assert_eq!(threads_per_job(None, 2, 8), 4);
+        assert_eq!(threads_per_job(None, 3, 8), 2);
+        assert_eq!(threads_per_job(None, 4, 2), 1, "at least one thread");
+        assert_eq!(threads_per_job(None, 0, 2), 2, "no workers: as one");
+        assert_eq!(threads_per_job(Some(3), 2, 2), 3, "as asked");
+        assert_eq!(threads_per_job(Some(0), 1, 2), 1);
+    }
 }
