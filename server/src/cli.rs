@@ -121,14 +121,15 @@ fn threads_per_job(asked: Option<usize>, workers: usize, cores: usize) -> usize 
 pub fn main() -> anyhow::Result<()> {
     let a = Args::parse();
     init_logs(a.log_format);
-    let threads_per_job = threads_per_job(a.threads_per_job, a.workers, cores());
-    if a.workers * threads_per_job > cores() {
+    let cores = cores();
+    let threads_per_job = threads_per_job(a.threads_per_job, a.workers, cores);
+    if a.workers * threads_per_job > cores {
         tracing::warn!(
             workers = a.workers,
             threads_per_job,
-            cores = cores(),
+            cores,
             "more job threads than cores: concurrent jobs will contend (--threads-per-job {} would not)",
-            (cores() / a.workers.max(1)).max(1)
+            self::threads_per_job(None, a.workers, cores)
         );
     }
     let cfg = Config {

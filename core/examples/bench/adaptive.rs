@@ -9,7 +9,7 @@
 //! defaults for `FLUIDBED_ADAPTIVE_S` simulated seconds (0.2), the fastest particle sampled every
 //! 40 DEM steps (50 µs). The last line: {"bench":"adaptive_step","dem_cost_ratio":…,…}.
 
-use crate::coupled::{shipped_case, state_at, FLUIDIZED_AT_S};
+use crate::coupled::{coupled_round, shipped_case, state_at, Tally, FLUIDIZED_AT_S};
 use fluidbed_core::sim::Simulation;
 use serde_json::json;
 
@@ -21,20 +21,17 @@ pub fn run() {
     let every = 40u64;
     let samples = (span / (every as f64 * dt)).round() as usize;
     let mut v_max = Vec::with_capacity(samples);
+    let mut tally = Tally::default();
     for _ in 0..samples {
-        let target = sim.steps() + every;
-        while sim.steps() < target {
-            sim.advance(target - sim.steps()).expect("coupled run stays stable");
-        }
+        coupled_round(&mut sim, every, &mut tally);
         let v2 = sim.dem().velocities().iter().map(|v| v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).fold(0.0, f64::max);
         v_max.push(v2.sqrt());
     }
     let v_ref = v_max.iter().copied().fold(0.0, f64::max);
     // DEM steps with the adaptive step per step of the shipped one, over the window.
     let cost = v_max.iter().map(|&v| (v / v_ref).powf(0.2)).sum::<f64>() / samples as f64;
-    let mut sorted = v_max.clone();
-    sorted.sort_by(f64::total_cmp);
-    let pct = |q: f64| sorted[((q * (samples - 1) as f64).round() as usize).min(samples - 1)];
+    v_max.sort_by(f64::total_cmp);
+    let pct = |q: f64| v_max[((q * (samples - 1) as f64).round() as usize).min(samples - 1)];
     let steps_per_contact = |v: f64| case.hertz_contact_time_s(2.0 * v) / dt;
     println!(
         "{}",
