@@ -81,6 +81,28 @@ pub struct Coupling {
     /// cfd/voidage_ramp.rs).
     #[serde(default)]
     pub gas_voidage: GasVoidage,
+    /// The particles' pressure-gradient force −V_p∇p between couplings: "held" (with the drag,
+    /// from the coupling's gas state) or "gas_step" (it follows the gas at each of its steps while
+    /// the drag stays held, so that the phases' pressure forces stay those of one gas state;
+    /// sim/pressure_follow.rs, docs/VALIDATION.md "The pressure force between couplings").
+    /// Not written when it is the default, so the cases of earlier versions keep their keys.
+    #[serde(default, skip_serializing_if = "PressureForce::is_held")]
+    pub pressure_force: PressureForce,
+}
+
+/// The particles' pressure-gradient force between couplings (`coupling.pressure_force`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum PressureForce {
+    #[default]
+    Held,
+    GasStep,
+}
+
+impl PressureForce {
+    fn is_held(&self) -> bool {
+        *self == PressureForce::Held
+    }
 }
 
 /// How the gas's voidage moves between couplings (`coupling.gas_voidage`).
@@ -100,6 +122,7 @@ impl Default for Coupling {
             interval_steps: d_coupling_interval(),
             drag_voidage_sublayers: d_drag_sublayers(),
             gas_voidage: GasVoidage::Held,
+            pressure_force: PressureForce::Held,
         }
     }
 }

@@ -63,7 +63,7 @@ pub fn cart_to_cyl(v: [f64; 3], cos: f64, sin: f64) -> [f64; 3] {
 
 /// (cos θ, sin θ) of the particle's angle; 1, 0 on the axis.
 #[inline]
-fn angle_of(x: f64, y: f64) -> (f64, f64) {
+pub(crate) fn angle_of(x: f64, y: f64) -> (f64, f64) {
     let r = (x * x + y * y).sqrt();
     if r > 0.0 {
         let inv = 1.0 / r;
@@ -313,6 +313,11 @@ impl Exchange {
         for row in &mut self.chunk_force[CHUNKS..] {
             row.clear();
         }
+    }
+
+    /// The drag cell of each particle at the last `particle_gas_forces` (the particles' order then).
+    pub fn cells(&self) -> &[u32] {
+        &self.cell_of
     }
 
     /// Remember a frozen bed (particles at rest for the whole run) for `frozen_cell_forces`.

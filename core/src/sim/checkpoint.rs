@@ -10,7 +10,9 @@
 //! DEM pair pass's chunk cuts to the `dem` section. The `analysis` section (the run's analysis
 //! samples) is optional: a file without it resumes with an empty analysis window; so is
 //! `gas_mass_budget` (cfd/mass_budget.rs): without it the budget starts at the resumed state; and
-//! `gas_voidage_ramp` (cfd/voidage_ramp.rs): without it the gas holds its voidage.
+//! `gas_voidage_ramp` (cfd/voidage_ramp.rs): without it the gas holds its voidage; and
+//! `pressure_follow` (sim/pressure_follow.rs): without it the particles' pressure force is held
+//! until the next coupling.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -55,6 +57,7 @@ pub(super) fn encode(st: &State) -> Vec<u8> {
         part("analysis", "bincode-1", bincode_of(&st.analysis), &[]),
         part("gas_mass_budget", "bincode-1", bincode_of(&st.gas.as_ref().map(|g| g.mass_budget())), &[]),
         part("gas_voidage_ramp", "bincode-1", bincode_of(&st.gas.as_ref().and_then(|g| g.voidage_ramp())), &[]),
+        part("pressure_follow", "bincode-1", bincode_of(&st.follow), &[]),
     ];
     let header =
         Header { format: FORMAT, writer: WRITER.into(), sections: parts.iter().map(|p| p.0.clone()).collect() };
@@ -151,7 +154,12 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
         Some(body) => bincode::deserialize(body).map_err(|e| refuse("analysis", e.to_string()))?,
         None => super::RunAnalysis::new(&case, &super::fluid_grid(&case)),
     };
-    Ok(State { case, plan, steps, snapshots_taken, dem, gas, analysis })
+    // A checkpoint from before the pressure force followed the gas holds it until the next coupling.
+    let follow = match sections.get("pressure_follow") {
+        Some(body) => bincode::deserialize(body).map_err(|e| refuse("pressure_follow", e.to_string()))?,
+        None => Default::default(),
+    };
+    Ok(State { case, plan, steps, snapshots_taken, dem, gas, analysis, follow })
 }
 
 /// The case and the run analysis of a checkpoint, read without the particle and gas state.
@@ -193,7 +201,17 @@ mod tests {
         let names: Vec<&str> = header.sections.iter().map(|s| s.name.as_str()).collect();
         assert_eq!(
             names,
-            ["case", "plan", "counters", "dem", "gas", "analysis", "gas_mass_budget", "gas_voidage_ramp"]
+            [
+                "case",
+                "plan",
+                "counters",
+                "dem",
+                "gas",
+                "analysis",
+                "gas_mass_budget",
+                "gas_voidage_ramp",
+                "pressure_follow"
+            ]
         );
         let dem = header.sections.iter().find(|s| s.name == "dem").unwrap();
         assert_eq!(dem.shapes["positions"], [4, 3]);
@@ -206,6 +224,7 @@ mod tests {
         // A section that no longer matches is refused with its name, shapes and both versions.
         let mut bad = bytes.clone();
         let cut = bad.len()
+            - sections["pressure_follow"].len()
             - sections["gas_voidage_ramp"].len()
             - sections["gas_mass_budget"].len()
             - sections["analysis"].len()

@@ -8,7 +8,7 @@
 //! (coupling/exchange.rs, `windowed_voidage`).
 
 use super::{watchdog, SimError, Simulation};
-use crate::case::GasVoidage;
+use crate::case::{GasVoidage, PressureForce};
 use crate::coupling::{
     layers_with_particles, voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod,
 };
@@ -167,6 +167,11 @@ impl Simulation {
             b.exchange.frozen_cell_forces(&self.grid, &at, par, &mut b.cell_force);
         }
         gas.interaction_force_mut().copy_from_slice(&b.cell_force);
+        if per_particle && self.st.case.coupling.pressure_force == PressureForce::GasStep {
+            let stamp = (self.st.dem.list_builds().0, gas.steps());
+            let m = b.sub.as_ref().map_or(1, |s| s.n);
+            self.st.follow.record(&self.grid, b.exchange.cells(), m, layers, &b.cell_grad_p, stamp);
+        }
         self.timers.voidage += (t1 - t0).as_secs_f64();
         self.timers.exchange += t1.elapsed().as_secs_f64();
     }
@@ -196,6 +201,16 @@ impl Simulation {
         Ok(())
     }
 
+    /// Between couplings with `coupling.pressure_force` = "gas_step": the particles' −V_p∇p moved
+    /// to the gas's current state (pressure_follow.rs).
+    fn follow_gas_pressure(&mut self) {
+        let t0 = std::time::Instant::now();
+        let (Some(gas), b) = (self.st.gas.as_mut(), &mut self.buf) else { return };
+        let scratch = (&mut b.cell_velocity[..], &mut b.cell_density[..], &mut b.cell_grad_p[..]);
+        self.st.follow.update(&self.grid, gas, &mut self.st.dem, scratch);
+        self.timers.exchange += t0.elapsed().as_secs_f64();
+    }
+
     /// One DEM step. Every `coupling_interval` DEM steps the gas is brought to the particles'
     /// time (`sync_gas`) and the voidage and the drag are recomputed (held in between); with
     /// gas_dt = DEM dt and an interval of 1: couple, one gas step, one DEM step — the paper's loop.
@@ -205,6 +220,9 @@ impl Simulation {
         if gas_on && self.st.steps.is_multiple_of(interval) {
             self.sync_gas()?;
             self.couple();
+        } else if gas_on && particles_move && self.st.case.coupling.pressure_force == PressureForce::GasStep {
+            self.sync_gas()?;
+            self.follow_gas_pressure();
         }
         let t0 = std::time::Instant::now();
         let before = self.st.dem.neighbour_seconds();

@@ -4,6 +4,7 @@
 mod checkpoint;
 mod coupled;
 pub mod plan;
+mod pressure_follow;
 pub mod run_analysis;
 pub mod snapshot;
 mod watchdog;
@@ -58,6 +59,9 @@ struct State {
     dem: DemSystem,
     gas: Option<GasSolver>,
     analysis: RunAnalysis,
+    /// The pressure force's state between couplings (`coupling.pressure_force` = "gas_step").
+    #[serde(default)]
+    follow: pressure_follow::PressureFollow,
 }
 
 /// Wall time spent per stage (seconds), for progress reports and benchmarks.
@@ -108,7 +112,7 @@ impl Simulation {
         let inflow = crate::cfd::case_stable_time_step(&case).unwrap_or(f64::INFINITY);
         let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt().min(inflow)));
         let analysis = RunAnalysis::new(&case, &grid);
-        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas, analysis };
+        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas, analysis, follow: Default::default() };
         let mut sim = Simulation::assemble(st, grid);
         sim.initial_voidage();
         Ok(sim)
@@ -168,6 +172,10 @@ impl Simulation {
     /// bench compares both from one state).
     pub fn set_gas_voidage(&mut self, how: crate::case::GasVoidage) {
         self.st.case.coupling.gas_voidage = how;
+    }
+    /// The particles' pressure force between couplings from the next coupling on (benchmarks).
+    pub fn set_pressure_force(&mut self, how: crate::case::PressureForce) {
+        self.st.case.coupling.pressure_force = how;
     }
     /// Change the set superficial velocity from now on (no new ramp); used by the U_mf sweep.
     pub fn set_superficial_velocity(&mut self, u: f64) {

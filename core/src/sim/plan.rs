@@ -86,8 +86,12 @@ impl Plan {
                 crate::case::GasVoidage::Interpolated => "interpolated",
                 crate::case::GasVoidage::Extrapolated => "extrapolated",
             };
+            let pressure = match case.coupling.pressure_force {
+                crate::case::PressureForce::Held => "held with it",
+                crate::case::PressureForce::GasStep => "following the gas at each of its steps",
+            };
             out.push(format!(
-                "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), the drag held in between and the gas's voidage {gas} (coupling.gas_voidage)",
+                "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), the drag held in between, the particles' pressure force {pressure} (coupling.pressure_force) and the gas's voidage {gas} (coupling.gas_voidage)",
                 self.coupling_interval
             ));
         }

@@ -69,6 +69,15 @@ fn resume_with_the_gas_voidage_interpolated_or_extrapolated_is_bit_identical() {
     }
 }
 
+#[test]
+fn resume_with_the_pressure_force_following_the_gas_is_bit_identical() {
+    // The cut falls between couplings, where each particle's −V_p∇p has moved with the gas since
+    // the coupling; the checkpoint carries the cells and the gradients it moves from.
+    let mut c = case();
+    c.coupling.pressure_force = crate::case::PressureForce::GasStep;
+    resume_is_bit_identical(c);
+}
+
 /// Run `case` straight and with a checkpoint and restore at `CUT`: the snapshots and the final
 /// state are the same bits. Returns the snapshots.
 fn resume_is_bit_identical(case: Case) -> Vec<Snapshot> {
