@@ -144,29 +144,34 @@ pub fn run() {
     // against error"): reported beside the others, not a default.
     long.set_coupling_interval(LONG_INTERVAL);
     long.set_gas_voidage(fluidbed_core::case::GasVoidage::Extrapolated);
-    // The defaults with the particles' pressure force following the gas (docs/VALIDATION.md, "The
-    // pressure force between couplings"): reported beside the others, not a default.
-    let mut follow = restore();
+    // The particles' pressure force following the gas (docs/VALIDATION.md, "The pressure force
+    // between couplings") at the default interval and at the longer one: not defaults.
+    let (mut follow, mut follow_long) = (restore(), restore());
     follow.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
+    follow_long.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
+    follow_long.set_coupling_interval(LONG_INTERVAL);
     let (mut ta, mut td, mut tp, mut tl) = (Tally::default(), Tally::default(), Tally::default(), Tally::default());
-    let mut tf = Tally::default();
+    let (mut tf, mut tfl) = (Tally::default(), Tally::default());
     for _ in 0..STEPS / ROUND {
         dem_round(&mut alone, ROUND, &mut ta);
         coupled_round(&mut default, ROUND, &mut td);
         coupled_round(&mut paper, ROUND, &mut tp);
         coupled_round(&mut long, ROUND, &mut tl);
         coupled_round(&mut follow, ROUND, &mut tf);
+        coupled_round(&mut follow_long, ROUND, &mut tfl);
     }
     let dt = case.dem.time_step_s;
     let plan = default.plan();
     let share = |t: &Tally| 1.0 - ta.per_step() / t.per_step();
     let long_name = format!("extrapolated_interval_{LONG_INTERVAL}");
+    let follow_long_name = format!("pressure_force_gas_step_interval_{LONG_INTERVAL}");
     let modes = [
         ("dem_alone", &ta),
         ("default", &td),
         ("paper", &tp),
         (long_name.as_str(), &tl),
         ("pressure_force_gas_step", &tf),
+        (follow_long_name.as_str(), &tfl),
     ];
     for (name, t) in modes {
         println!(

@@ -10,7 +10,8 @@
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
-//! `coupling.drag_voidage_sublayers`). `umf-paper-cells` runs the same sweep with dz = dr and the
+//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` = 1, the case's `coupling.pressure_force`
+//! = "gas_step"). `umf-paper-cells` runs the same sweep with dz = dr and the
 //! drag voidage on 8 sub-layers per cell.
 
 use crate::common::*;
@@ -29,6 +30,8 @@ struct Sweep {
     dz_over_dr: f64,
     /// `coupling.drag_voidage_sublayers` (None: the case's).
     sublayers: Option<u32>,
+    /// `coupling.pressure_force` = "gas_step" (false: the case's).
+    pressure_gas_step: bool,
 }
 
 impl Sweep {
@@ -44,6 +47,7 @@ impl Sweep {
             hold: 0.1,
             dz_over_dr: 0.5,
             sublayers: None,
+            pressure_gas_step: false,
         }
     }
 
@@ -63,7 +67,8 @@ impl Sweep {
                 "hold" => s.hold = x,
                 "dz_over_dr" => s.dz_over_dr = x,
                 "sublayers" => s.sublayers = Some(x as u32),
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers)"),
+                "pressure_gas_step" => s.pressure_gas_step = x != 0.0,
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step)"),
             }
         }
         s
@@ -88,6 +93,9 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
         case.column.diameter_m = sw.column_mm / 1000.0;
         case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
         // (the shipped case's voidage: its boxes and cube are set by d, not by the column)
+    }
+    if sw.pressure_gas_step {
+        case.coupling.pressure_force = fluidbed_core::case::PressureForce::GasStep;
     }
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;
