@@ -10,9 +10,9 @@
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
-//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` = 1, the case's `coupling.pressure_force`
-//! = "gas_step"). `umf-paper-cells` runs the same sweep with dz = dr and the
-//! drag voidage on 8 sub-layers per cell.
+//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step`, 1 or 0 for the case's
+//! `coupling.pressure_force` "gas_step" or not). `umf-paper-cells` runs the same sweep with dz = dr,
+//! the drag voidage on 8 sub-layers per cell and the pressure force following the gas.
 
 use crate::common::*;
 use serde_json::json;
@@ -80,9 +80,12 @@ pub fn run() -> serde_json::Value {
 }
 
 /// The same sweep on the paper's cells (dz = dr) with the drag voidage on 8 sub-layers per cell
-/// (`coupling.drag_voidage_sublayers`, docs/VALIDATION.md "U_mf with the paper's cells").
+/// (`coupling.drag_voidage_sublayers`) and the particles' pressure force following the gas between
+/// couplings (`coupling.pressure_force` = "gas_step", which gives the bed's ΔP of the paper's
+/// every-step coupling at the interval of 10; docs/VALIDATION.md "U_mf with the paper's cells" and
+/// "The pressure force between couplings").
 pub fn run_paper_cells() -> serde_json::Value {
-    let base = Sweep { dz_over_dr: 1.0, sublayers: Some(8), ..Sweep::shipped() };
+    let base = Sweep { dz_over_dr: 1.0, sublayers: Some(8), pressure_gas_step: true, ..Sweep::shipped() };
     sweep(Sweep::from_env(base), "umf-paper-cells", "docs/img/umf_paper_cells.png")
 }
 
@@ -165,7 +168,7 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     crate::plots::umf_curve(&points, want_weight, umf, &png);
     let reference = 0.30;
     eprintln!("{n} particles, bed weight/area {want_weight:.1} Pa: U_mf = {umf:.3} m/s (reference {reference})");
-    json!({"name": name, "figure": umf, "dz_over_dr": sw.dz_over_dr, "drag_voidage_sublayers": sw.sublayers.unwrap_or(1), "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
+    json!({"name": name, "figure": umf, "dz_over_dr": sw.dz_over_dr, "drag_voidage_sublayers": sw.sublayers.unwrap_or(1), "pressure_force_gas_step": sw.pressure_gas_step, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
            "points": points.iter().map(|(u, p)| json!({"u_m_s": u, "dp_pa": p})).collect::<Vec<_>>()})
 }
 
