@@ -119,22 +119,13 @@ mod tests {
     use crate::case::{Case, PressureForce};
     use crate::coupling::exchange::{angle_of, cyl_to_cart};
 
+    /// The resume tests' bed (1,600 particles, a poured bed, gas sub-cycled), coupled every 6
+    /// DEM steps with the pressure force following the gas.
     fn case() -> Case {
-        serde_json::from_str(
-            r#"{"name":"follow","column":{"diameter_m":0.016,"height_m":0.048},
-                "particles":{"diameter_m":0.0012,"density_kg_m3":1000.0,"youngs_modulus_pa":1.0e7,
-                  "poisson_ratio":0.33,"sliding_friction":0.1,
-                  "normal_damping":{"tsuji_alpha":0.02},"tangential_damping":{"tsuji_alpha":0.0001}},
-                "bed":{"generated":{"count":1600,"seed":4}},
-                "dem":{"time_step_s":4.0e-6},
-                "gas":{"superficial_velocity_m_s":0.9,"ramp_time_s":0.001},
-                "grid":{"dr_m":0.004,"n0":3},
-                "voidage":{"method":"square_grid","split":"cuboid"},
-                "coupling":{"interval_steps":6,"pressure_force":"gas_step"},
-                "outputs":{"snapshot_interval_s":1.0,"fields":["pressure"]},
-                "end_time_s":0.01}"#,
-        )
-        .unwrap()
+        let mut c = super::super::resume_tests::case();
+        c.coupling.interval_steps = 6;
+        c.coupling.pressure_force = PressureForce::GasStep;
+        c
     }
 
     #[test]

@@ -10,7 +10,8 @@ use super::*;
 const STEPS: u64 = 1002;
 const CUT: u64 = 500;
 
-fn case() -> Case {
+/// The resume case (also the pressure-force test's, pressure_follow.rs).
+pub(super) fn case() -> Case {
     let mut c: Case = serde_json::from_str(
         r#"{"name":"resume","column":{"diameter_m":0.016,"height_m":0.048},
             "particles":{"diameter_m":0.0012,"density_kg_m3":1000.0,"youngs_modulus_pa":1.0e7,
