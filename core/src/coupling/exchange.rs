@@ -61,6 +61,13 @@ pub fn cart_to_cyl(v: [f64; 3], cos: f64, sin: f64) -> [f64; 3] {
     [v[0] * cos + v[1] * sin, -v[0] * sin + v[1] * cos, v[2]]
 }
 
+/// The fluid cell that drag sub-cell `s` lies in, on a grid of `m` sub-layers per fluid layer of
+/// `per` cells (sub-layers keep the layer's cells).
+#[inline]
+pub(crate) fn fluid_cell(s: usize, per: usize, m: usize) -> usize {
+    (s / per / m) * per + s % per
+}
+
 /// (cos θ, sin θ) of the particle's angle; 1, 0 on the axis.
 #[inline]
 pub(crate) fn angle_of(x: f64, y: f64) -> (f64, f64) {
@@ -221,7 +228,7 @@ impl Exchange {
         table.resize(drag_cells, CellTable::default());
         let basis = &self.cell_basis;
         table[..used].par_iter_mut().with_min_len(256).enumerate().for_each(|(s, t)| {
-            let c = (s / per / m) * per + s % per;
+            let c = fluid_cell(s, per, m);
             let eps = clamp_voidage(drag.voidage[s], par.eps_min);
             let u = gas.velocity_cyl[c];
             let u_cyl = if m == 1 {

@@ -15,7 +15,7 @@
 //! (docs/VALIDATION.md, "The pressure force between couplings").
 
 use crate::cfd::GasSolver;
-use crate::coupling::exchange::{angle_of, cyl_to_cart};
+use crate::coupling::exchange::{angle_of, cyl_to_cart, fluid_cell};
 use crate::dem::DemSystem;
 use crate::grid::CylGrid;
 use rayon::prelude::*;
@@ -30,9 +30,8 @@ pub(super) struct PressureFollow {
     /// Fluid cell of each particle, in the particles' order of list build `build`.
     cells: Vec<u32>,
     build: u64,
-    /// Layers holding particles at the coupling; the gradients cover their cells.
-    layers: usize,
-    /// ∇p per cell, (r, θ, z) in the cell's basis, that the particles' forces carry now.
+    /// ∇p per cell of the layers holding particles at the coupling, (r, θ, z) in the cell's
+    /// basis, that the particles' forces carry now.
     grad: Vec<[f64; 3]>,
     /// The gas's step count when `grad` was read.
     gas_steps: u64,
@@ -52,13 +51,9 @@ impl PressureFollow {
     ) {
         let (per, m) = (grid.cells_per_layer(), sublayers.max(1));
         self.cells.clear();
-        self.cells.extend(drag_cells.iter().map(|&s| {
-            let s = s as usize;
-            ((s / per / m) * per + s % per) as u32
-        }));
-        self.layers = layers.min(grid.nz);
+        self.cells.extend(drag_cells.iter().map(|&s| fluid_cell(s as usize, per, m) as u32));
         self.grad.clear();
-        self.grad.extend_from_slice(&grad[..self.layers * per]);
+        self.grad.extend_from_slice(&grad[..layers.min(grid.nz) * per]);
         (self.build, self.gas_steps) = (build, gas_steps);
     }
 
@@ -76,9 +71,8 @@ impl PressureFollow {
             return;
         }
         let (vel, rho, grad_new) = scratch;
-        gas.exchange_fields(self.layers, vel, rho, grad_new);
-        let per = grid.cells_per_layer();
-        let used = self.layers * per;
+        let used = self.grad.len();
+        gas.exchange_fields(used / grid.cells_per_layer(), vel, rho, grad_new);
         let build = dem.list_builds().0;
         if build != self.build || self.cells.len() != dem.len() {
             // The particles were re-sorted: their cells now.
