@@ -3,7 +3,7 @@
 //! to erupt at the top of the bed"). The paper's bed (50 mm, 110 mm settled, ≈ 150k particles for
 //! several seconds) does not fit a session on 2 cores, so this reads beds that do:
 //! - the 44-mm bubbling bed at 0.6 m/s (the run of `bubbling`, 2 simulated s);
-//! - the 44-mm, 90-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
+//! - the 44-mm, 160-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
 //!   paper's 0.563 m/s), where their runs have finished (this never starts them).
 //!
 //! Each run's analysis (accumulated while it ran) gives ΔP's dominant frequency, the eruptions at

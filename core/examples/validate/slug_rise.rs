@@ -1,11 +1,13 @@
 //! Slug rise velocity (issue: science, paper section 3.4 and Fig. 8): a tall bed of the paper's
 //! particles — the bubbling case's 44-mm column and grid (dr 4.4 mm, layers dr/2, its voidage),
-//! 90 mm settled (≈ 90k particles), 0.22 m tall — at four velocities between 1.2 and 2 U_mf. (The
-//! 22-mm column, D/d = 18, made flat wall-spanning plugs, for which the formula is not meant:
-//! docs/VALIDATION.md; 44 mm is D/d = 37, near the paper's 50-mm tube.) Each run's
+//! 160 mm settled as the paper's slugging bed (≈ 165k particles), 0.32 m tall — at four velocities
+//! between 1.2 and 2 U_mf. (The 22-mm column, D/d = 18, made flat wall-spanning plugs, for which
+//! the formula is not meant, and a 90-mm bed in the 44-mm column had only growing bubbles at its
+//! probes: docs/VALIDATION.md; 44 mm is D/d = 37, near the paper's 50-mm tube.) Each run's
 //! analysis (accumulated while it runs, from `FROM_S` to `END_S`) gives the rise velocity by
-//! cross-correlating the cross-section voidage at 30% and 70% of the time-averaged bed height
-//! (Müller et al. 2007a, as the paper did), against Stewart & Davidson (1967):
+//! cross-correlating the cross-section voidage at 120 and 160 mm above the distributor (the paper:
+//! slugs fully formed from ≈ 120 mm, measured at 140 mm; Müller et al. 2007a's method), against
+//! Stewart & Davidson (1967):
 //! u_s = (U − U_mf) + 0.35 √(g D), with U_mf = 0.30 m/s (the paper's measured value).
 //! Figure: the worst relative error of the four; beside it the slope of u_s against U − U_mf
 //! (the paper's point that U − U_mf belongs in the formula: near 1).
@@ -13,7 +15,7 @@
 //! Each velocity is a long run (≈ 2.6 simulated s): it keeps a checkpoint in target/validate-cache
 //! every 0.05 s and resumes there; a finished run keeps its last checkpoint there and is not run
 //! again (its analysis is read from that checkpoint by the current build). Voidage slices
-//! of the last snapshots go to docs/img/slug_rise_44mm_U*.png, to tell round-nosed slugs from
+//! of the last snapshots go to docs/img/slug_rise_44mm_160mm_U*.png, to tell round-nosed slugs from
 //! wall-spanning plugs.
 
 use crate::common::*;
@@ -27,11 +29,14 @@ use serde_json::json;
 const VELOCITIES: [f64; 4] = [0.54, 0.60, 0.425, 0.37];
 /// U_mf of the formula (the paper's measured value; `validate -- umf` for the model's).
 const UMF: f64 = 0.30;
-/// Start of the analysis window (after the 0.24-s ramp and the first slugs) and the end.
-const FROM_S: f64 = 0.6;
-const END_S: f64 = 2.6;
-const SETTLED_M: f64 = 0.09;
-const COLUMN_M: f64 = 0.22;
+/// Start of the analysis window (after the 0.24-s ramp and the first slugs through the probes) and
+/// the end: 2 s of slugging.
+const FROM_S: f64 = 0.8;
+const END_S: f64 = 2.8;
+const SETTLED_M: f64 = 0.16;
+const COLUMN_M: f64 = 0.32;
+/// The two cross-sections of the rise velocity (m above the distributor), about the paper's 140 mm.
+const PROBES_M: [f64; 2] = [0.12, 0.16];
 
 /// What a finished run keeps beside its last checkpoint.
 #[derive(Serialize, Deserialize)]
@@ -62,6 +67,7 @@ fn case(u: f64) -> Case {
     c.outputs.snapshot_interval_s = 0.01;
     c.outputs.fields = vec![Field::Voidage];
     c.analysis.from_s = FROM_S;
+    c.analysis.rise_heights_m = Some(PROBES_M);
     let report = c.validate();
     assert!(report.is_ok(), "slug-rise case invalid: {:?}", report.errors);
     c
@@ -117,7 +123,7 @@ fn run_at(u: f64) -> Finished {
         let ms = (s.time_s * 1000.0).round() as i64;
         if ms > (END_S * 1000.0) as i64 - 60 && ms % 20 == 0 {
             let eps = s.voidage.as_ref().expect("voidage field");
-            crate::plots::voidage_slice(&s, eps, &format!("docs/img/slug_rise_44mm_U{u}_{ms:04}ms.png"));
+            crate::plots::voidage_slice(&s, eps, &format!("docs/img/slug_rise_44mm_160mm_U{u}_{ms:04}ms.png"));
         }
         if s.index % 5 == 0 {
             let wall = wall_before + t0.elapsed().as_secs_f64();
@@ -182,7 +188,7 @@ pub fn run() -> serde_json::Value {
     let s = if excess.len() >= 2 { slope(&excess, &measured) } else { f64::NAN };
     json!({"name": "slug-rise", "figure": figure, "reference": reference, "rel_err": rel_err,
         "slope_vs_u_minus_umf": s, "points": points, "column_diameter_m": d, "umf_m_s": UMF,
-        "note": "worst of four velocities; rise velocity by cross-correlation of the cross-section voidage at 30% and 70% of the mean bed height"})
+        "note": "worst of four velocities; rise velocity by cross-correlation of the cross-section voidage at 120 and 160 mm above the distributor"})
 }
 
 #[cfg(test)]
