@@ -1,6 +1,6 @@
 //! Slug rise velocity (issue: science, paper section 3.4 and Fig. 8): a tall bed of the paper's
 //! particles — the bubbling case's 44-mm column and grid (dr 4.4 mm, layers dr/2, its voidage),
-//! 160 mm settled as the paper's slugging bed (≈ 165k particles), 0.32 m tall — at four velocities
+//! 160 mm settled as the paper's slugging bed (≈ 165k particles), 0.321 m tall — at four velocities
 //! between 1.2 and 2 U_mf. (The 22-mm column, D/d = 18, made flat wall-spanning plugs, for which
 //! the formula is not meant, and a 90-mm bed in the 44-mm column had only growing bubbles at its
 //! probes: docs/VALIDATION.md; 44 mm is D/d = 37, near the paper's 50-mm tube.) Each run's
@@ -34,7 +34,7 @@ const UMF: f64 = 0.30;
 const FROM_S: f64 = 0.8;
 const END_S: f64 = 2.8;
 const SETTLED_M: f64 = 0.16;
-const COLUMN_M: f64 = 0.32;
+const COLUMN_M: f64 = 0.3212; // 146 layers of 2.2 mm
 /// The two cross-sections of the rise velocity (m above the distributor), about the paper's 140 mm.
 const PROBES_M: [f64; 2] = [0.12, 0.16];
 
