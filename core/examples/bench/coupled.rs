@@ -150,6 +150,10 @@ pub fn run() {
     follow.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
     follow_long.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
     follow_long.set_coupling_interval(LONG_INTERVAL);
+    // Held at the mean of the gas's gradient over the last interval (sim/pressure_mean.rs).
+    let mut mean = restore();
+    mean.set_pressure_force(fluidbed_core::case::PressureForce::IntervalMean);
+    let mut tm = Tally::default();
     let (mut ta, mut td, mut tp, mut tl) = (Tally::default(), Tally::default(), Tally::default(), Tally::default());
     let (mut tf, mut tfl) = (Tally::default(), Tally::default());
     for _ in 0..STEPS / ROUND {
@@ -159,6 +163,7 @@ pub fn run() {
         coupled_round(&mut long, ROUND, &mut tl);
         coupled_round(&mut follow, ROUND, &mut tf);
         coupled_round(&mut follow_long, ROUND, &mut tfl);
+        coupled_round(&mut mean, ROUND, &mut tm);
     }
     let dt = case.dem.time_step_s;
     let plan = default.plan();
@@ -172,6 +177,7 @@ pub fn run() {
         (long_name.as_str(), &tl),
         ("pressure_force_gas_step", &tf),
         (follow_long_name.as_str(), &tfl),
+        ("pressure_force_interval_mean", &tm),
     ];
     for (name, t) in modes {
         println!(

@@ -84,7 +84,10 @@ pub struct Coupling {
     /// The particles' pressure-gradient force −V_p∇p between couplings: "held" (with the drag,
     /// from the coupling's gas state) or "gas_step" (it follows the gas at each of its steps while
     /// the drag stays held, so that the phases' pressure forces stay those of one gas state;
-    /// sim/pressure_follow.rs, docs/VALIDATION.md "The pressure force between couplings").
+    /// sim/pressure_follow.rs, docs/VALIDATION.md "The pressure force between couplings") or
+    /// "interval_mean" (held, at the mean of the gas's ∇p over its steps of the last interval: the
+    /// particles receive the pressure impulse the gas felt, one interval late, at no cost between
+    /// couplings; sim/pressure_mean.rs).
     /// Not written when it is the default, so the cases of earlier versions keep their keys.
     #[serde(default, skip_serializing_if = "PressureForce::is_held")]
     pub pressure_force: PressureForce,
@@ -97,6 +100,7 @@ pub enum PressureForce {
     #[default]
     Held,
     GasStep,
+    IntervalMean,
 }
 
 impl PressureForce {

@@ -358,6 +358,17 @@ impl GasSolver {
         [gr, gt, gz]
     }
 
+    /// ∇p (Cartesian, per cell) of the state at the start of the last step, as its right-hand
+    /// side's momentum equation used it (the Green–Gauss gradient of `pressure_gradient_cyl`).
+    pub fn last_step_pressure_gradient(&self) -> (&[f64], &[f64], &[f64]) {
+        (&self.prim.gx, &self.prim.gy, &self.prim.gz)
+    }
+
+    /// A horizontal Cartesian vector of cell `cell` in the cell's cylindrical basis (r, θ).
+    pub fn horizontal_to_cylindrical(&self, cell: usize, x: f64, y: f64) -> (f64, f64) {
+        self.geo.to_cylindrical(cell % self.grid.cells_per_layer(), x, y)
+    }
+
     /// Largest stable step for the current state (acoustic CFL inside AB3's region; stability.rs).
     pub fn stable_dt(&self) -> f64 {
         let p = &self.st.params;

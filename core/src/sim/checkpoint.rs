@@ -12,7 +12,8 @@
 //! `gas_mass_budget` (cfd/mass_budget.rs): without it the budget starts at the resumed state; and
 //! `gas_voidage_ramp` (cfd/voidage_ramp.rs): without it the gas holds its voidage; and
 //! `pressure_follow` (sim/pressure_follow.rs): without it the particles' pressure force is held
-//! until the next coupling.
+//! until the next coupling; and `pressure_mean` (sim/pressure_mean.rs): without it the next
+//! coupling's mean starts from its steps on.
 
 use super::State;
 use serde::{Deserialize, Serialize};
@@ -58,6 +59,7 @@ pub(super) fn encode(st: &State) -> Vec<u8> {
         part("gas_mass_budget", "bincode-1", bincode_of(&st.gas.as_ref().map(|g| g.mass_budget())), &[]),
         part("gas_voidage_ramp", "bincode-1", bincode_of(&st.gas.as_ref().and_then(|g| g.voidage_ramp())), &[]),
         part("pressure_follow", "bincode-1", bincode_of(&st.follow), &[]),
+        part("pressure_mean", "bincode-1", bincode_of(&st.mean), &[]),
     ];
     let header =
         Header { format: FORMAT, writer: WRITER.into(), sections: parts.iter().map(|p| p.0.clone()).collect() };
@@ -159,7 +161,11 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
         Some(body) => bincode::deserialize(body).map_err(|e| refuse("pressure_follow", e.to_string()))?,
         None => Default::default(),
     };
-    Ok(State { case, plan, steps, snapshots_taken, dem, gas, analysis, follow })
+    let mean = match sections.get("pressure_mean") {
+        Some(body) => bincode::deserialize(body).map_err(|e| refuse("pressure_mean", e.to_string()))?,
+        None => Default::default(),
+    };
+    Ok(State { case, plan, steps, snapshots_taken, dem, gas, analysis, follow, mean })
 }
 
 /// The case and the run analysis of a checkpoint, read without the particle and gas state.
@@ -210,7 +216,8 @@ mod tests {
                 "analysis",
                 "gas_mass_budget",
                 "gas_voidage_ramp",
-                "pressure_follow"
+                "pressure_follow",
+                "pressure_mean"
             ]
         );
         let dem = header.sections.iter().find(|s| s.name == "dem").unwrap();
@@ -224,6 +231,7 @@ mod tests {
         // A section that no longer matches is refused with its name, shapes and both versions.
         let mut bad = bytes.clone();
         let cut = bad.len()
+            - sections["pressure_mean"].len()
             - sections["pressure_follow"].len()
             - sections["gas_voidage_ramp"].len()
             - sections["gas_mass_budget"].len()

@@ -24,6 +24,10 @@ pub(super) struct Buffers {
     pub cell_grad_p: Vec<[f64; 3]>,
     pub cell_force: Vec<[f64; 3]>,
     pub exchange: Exchange,
+    /// The particles' identities in their order at the exchange's last call, and the DEM's list
+    /// build then: after a re-sort the exchange's cell hints are carried to the new order.
+    pub hint_ids: Vec<u32>,
+    pub hint_build: u64,
     /// The voidage of a frozen bed is computed once.
     pub voidage_fresh: bool,
     /// Drag-voidage sub-layers: their grid (n layers per fluid layer), solid volume and voidage.
@@ -77,6 +81,8 @@ impl Buffers {
             cell_grad_p: vec![[0.0; 3]; cells],
             cell_force: vec![[0.0; 3]; cells],
             exchange: Exchange::new(grid, particles),
+            hint_ids: Vec::new(),
+            hint_build: 0,
             voidage_fresh: false,
             sub: (sublayers > 1).then(|| SubLayers::new(grid, sublayers)),
         }
@@ -141,6 +147,10 @@ impl Simulation {
         // The layers that hold particles (with sub-layers, the drag reads its fluid cells' fields).
         let layers = layers_with_particles(&self.grid, self.st.dem.positions());
         gas.exchange_fields(layers, &mut b.cell_velocity, &mut b.cell_density, &mut b.cell_grad_p);
+        if self.st.case.coupling.pressure_force == PressureForce::IntervalMean {
+            let next = (layers + 2).min(self.grid.nz) * self.grid.cells_per_layer();
+            self.st.mean.take_mean(gas, &mut b.cell_grad_p, next);
+        }
         let g = self.st.case.gas.as_ref().expect("gas section");
         let at = GasAtCells {
             velocity_cyl: &b.cell_velocity,
@@ -161,6 +171,13 @@ impl Simulation {
                 None => DragCells::cells(&self.grid, &b.voidage),
                 Some(s) => DragCells { grid: &s.grid, sublayers: s.n, voidage: &s.voidage },
             };
+            let build = dem.list_builds().0;
+            if build != b.hint_build {
+                b.exchange.carry_hints(&b.hint_ids, dem.ids());
+                b.hint_ids.clear();
+                b.hint_ids.extend_from_slice(dem.ids());
+                b.hint_build = build;
+            }
             let (pos, vel, ext) = dem.coupling_views();
             b.exchange.particle_gas_forces(&self.grid, drag, &at, par, (pos, vel), ext, &mut b.cell_force);
         } else {
@@ -190,9 +207,13 @@ impl Simulation {
         // Gas steps that reach the end of the DEM steps taken (to within rounding).
         let target = (self.st.steps as f64 * dt / dt_g - 1e-9).ceil().max(0.0) as u64;
         let gas = self.st.gas.as_mut().expect("gas");
+        let mean = plan.particles_move && self.st.case.coupling.pressure_force == PressureForce::IntervalMean;
         let t0 = std::time::Instant::now();
         while gas.steps() < target {
             gas.step(dt_g);
+            if mean {
+                self.st.mean.add_step(gas);
+            }
             if gas.steps().is_multiple_of(watchdog::GAS_CHECK_EVERY) {
                 watchdog::check_gas(gas, &self.limits, dt_g, gas.time(), self.st.steps)?;
             }

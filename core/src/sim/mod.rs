@@ -5,6 +5,7 @@ mod checkpoint;
 mod coupled;
 pub mod plan;
 mod pressure_follow;
+mod pressure_mean;
 pub mod run_analysis;
 pub mod snapshot;
 mod watchdog;
@@ -62,6 +63,10 @@ struct State {
     /// The pressure force's state between couplings (`coupling.pressure_force` = "gas_step").
     #[serde(default)]
     follow: pressure_follow::PressureFollow,
+    /// The pressure force's sum over the gas steps of an interval (`coupling.pressure_force` =
+    /// "interval_mean").
+    #[serde(default)]
+    mean: pressure_mean::PressureMean,
 }
 
 /// Wall time spent per stage (seconds), for progress reports and benchmarks.
@@ -112,7 +117,17 @@ impl Simulation {
         let inflow = crate::cfd::case_stable_time_step(&case).unwrap_or(f64::INFINITY);
         let plan = Plan::for_case(&case, dem.len(), gas.as_ref().map(|g| g.stable_dt().min(inflow)));
         let analysis = RunAnalysis::new(&case, &grid);
-        let st = State { case, plan, steps: 0, snapshots_taken: 0, dem, gas, analysis, follow: Default::default() };
+        let st = State {
+            case,
+            plan,
+            steps: 0,
+            snapshots_taken: 0,
+            dem,
+            gas,
+            analysis,
+            follow: Default::default(),
+            mean: Default::default(),
+        };
         let mut sim = Simulation::assemble(st, grid);
         sim.initial_voidage();
         Ok(sim)

@@ -89,6 +89,7 @@ impl Plan {
             let pressure = match case.coupling.pressure_force {
                 crate::case::PressureForce::Held => "held with it",
                 crate::case::PressureForce::GasStep => "following the gas at each of its steps",
+                crate::case::PressureForce::IntervalMean => "held at the mean of the gas's over the last interval",
             };
             out.push(format!(
                 "voidage and drag: recomputed every {} DEM steps (coupling.interval_steps), the drag held in between, the particles' pressure force {pressure} (coupling.pressure_force) and the gas's voidage {gas} (coupling.gas_voidage)",

@@ -79,6 +79,14 @@ fn resume_with_the_pressure_force_following_the_gas_is_bit_identical() {
     resume_is_bit_identical(c);
 }
 
+#[test]
+fn resume_with_the_interval_mean_pressure_force_is_bit_identical() {
+    // The cut falls between couplings, where the sum of the gas's gradients is part of the state.
+    let mut c = case();
+    c.coupling.pressure_force = crate::case::PressureForce::IntervalMean;
+    resume_is_bit_identical(c);
+}
+
 /// Run `case` straight and with a checkpoint and restore at `CUT`: the snapshots and the final
 /// state are the same bits. Returns the snapshots.
 fn resume_is_bit_identical(case: Case) -> Vec<Snapshot> {
