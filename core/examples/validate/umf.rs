@@ -10,8 +10,8 @@
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
-//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step`, 1 or 0 for the case's
-//! `coupling.pressure_force` "gas_step" or not). `umf-paper-cells` runs the same sweep with dz = dr,
+//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` or `pressure_mean`, 1 for the case's
+//! `coupling.pressure_force` "gas_step" or "interval_mean", 0 for not). `umf-paper-cells` runs the same sweep with dz = dr,
 //! the drag voidage on 8 sub-layers per cell and the pressure force following the gas.
 
 use crate::common::*;
@@ -32,6 +32,8 @@ struct Sweep {
     sublayers: Option<u32>,
     /// `coupling.pressure_force` = "gas_step" (false: the case's).
     pressure_gas_step: bool,
+    /// `coupling.pressure_force` = "interval_mean" (false: the case's, or gas_step above).
+    pressure_mean: bool,
 }
 
 impl Sweep {
@@ -48,6 +50,7 @@ impl Sweep {
             dz_over_dr: 0.5,
             sublayers: None,
             pressure_gas_step: false,
+            pressure_mean: false,
         }
     }
 
@@ -68,7 +71,8 @@ impl Sweep {
                 "dz_over_dr" => s.dz_over_dr = x,
                 "sublayers" => s.sublayers = Some(x as u32),
                 "pressure_gas_step" => s.pressure_gas_step = x != 0.0,
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step)"),
+                "pressure_mean" => s.pressure_mean = x != 0.0,
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean)"),
             }
         }
         s
@@ -100,6 +104,9 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     if sw.pressure_gas_step {
         case.coupling.pressure_force = fluidbed_core::case::PressureForce::GasStep;
     }
+    if sw.pressure_mean {
+        case.coupling.pressure_force = fluidbed_core::case::PressureForce::IntervalMean;
+    }
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;
     }
@@ -123,6 +130,7 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![fluidbed_core::case::Field::Pressure];
     case.end_time_s = 0.15 + hold * (speeds.len() - 1) as f64;
+    let pressure_force = case.coupling.pressure_force;
     let mut sim = fluidbed_core::sim::Simulation::new(case, Some(&bed_cache())).expect("build");
     let n = sim.dem().len();
     let want_weight = bed_weight_per_area(sim.case(), n, sim.case().gas.as_ref().unwrap().outlet_density_kg_m3());
@@ -168,7 +176,7 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     crate::plots::umf_curve(&points, want_weight, umf, &png);
     let reference = 0.30;
     eprintln!("{n} particles, bed weight/area {want_weight:.1} Pa: U_mf = {umf:.3} m/s (reference {reference})");
-    json!({"name": name, "figure": umf, "dz_over_dr": sw.dz_over_dr, "drag_voidage_sublayers": sw.sublayers.unwrap_or(1), "pressure_force_gas_step": sw.pressure_gas_step, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
+    json!({"name": name, "figure": umf, "dz_over_dr": sw.dz_over_dr, "drag_voidage_sublayers": sw.sublayers.unwrap_or(1), "pressure_force": pressure_force, "reference": reference, "rel_err": umf / reference - 1.0, "bed_weight_pa": want_weight, "bed_voidage": voidages,
            "points": points.iter().map(|(u, p)| json!({"u_m_s": u, "dp_pa": p})).collect::<Vec<_>>()})
 }
 
