@@ -17,7 +17,7 @@ pub struct SquareGrid {
     split: BoxSplit,
     cube_side_factor: f64,
     scatter: Scatter<()>,
-    /// Solid volume per box (layer-major: (k·nb + by)·nb + bx), one buffer per fixed chunk.
+    /// Solid volume per box of the layers each fixed chunk reaches, one buffer per chunk.
     box_volume: Vec<BoxSums>,
 }
 
@@ -59,7 +59,10 @@ impl VoidageMethod for SquareGrid {
     }
 }
 
-/// One chunk's solid volume per box, and the layers it filled this call (the rest is stale).
+/// One chunk's solid volume per box of the layers it reaches this call, `layers`: box (k, by, bx)
+/// at ((k − layers.start)·nb + by)·nb + bx. Sized to those layers, not the column's (the
+/// freeboard holds no solid); the buffer keeps its largest size, so calls do not allocate once the
+/// bed has reached its height.
 #[derive(Clone, Default)]
 struct BoxSums {
     volume: Vec<f64>,
@@ -80,9 +83,8 @@ fn two_stage_cuboid(
 ) {
     use rayon::prelude::*;
     let nb = bg.nb;
-    let nboxes = nb * nb * g.nz;
-    if bufs.len() != BOX_CHUNKS || bufs[0].volume.len() != nboxes {
-        *bufs = vec![BoxSums { volume: vec![0.0; nboxes], layers: 0..0 }; BOX_CHUNKS];
+    if bufs.len() != BOX_CHUNKS {
+        *bufs = vec![BoxSums::default(); BOX_CHUNKS];
     }
     let vp = 4.0 / 3.0 * PI * radius.powi(3);
     let chunk = positions.len().div_ceil(BOX_CHUNKS).max(1);
@@ -96,15 +98,32 @@ fn two_stage_cuboid(
         let hi = ((n + 1) * chunk).min(positions.len());
         let (z_min, z_max) =
             positions[lo..hi].iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| (a.min(p[2]), b.max(p[2])));
-        let (k0, k1) = if lo == hi { (0, 0) } else { (up.cell(z_min - h / 2.0), up.cell(z_max + h / 2.0) + 1) };
+        // One layer more at each end: the split's cell of an end can round to the neighbour of
+        // `Axis::cell`'s, and its second pair names the next layer even at a zero share.
+        let (k0, k1) = if lo == hi {
+            (0, 0)
+        } else {
+            (up.cell(z_min - h / 2.0).saturating_sub(1), (up.cell(z_max + h / 2.0) + 2).min(g.nz))
+        };
         sums.layers = k0..k1;
         let buf = &mut sums.volume;
-        buf[k0 * nb * nb..k1 * nb * nb].fill(0.0);
+        buf.clear();
+        buf.resize((k1 - k0) * nb * nb, 0.0);
+        // Box indices below are the column's, less the first layer's.
+        let base = k0 * nb * nb;
         let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
         let across = Axis::new(bg.origin, bg.dl, nb);
         if h <= bg.dl && h <= g.dz {
             // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
-            deposit_small_cubes_on(&positions[lo..hi], SplitTwo::new(&across, h), SplitTwo::new(&up, h), nb, vp, buf);
+            deposit_small_cubes_on(
+                &positions[lo..hi],
+                SplitTwo::new(&across, h),
+                SplitTwo::new(&up, h),
+                nb,
+                base,
+                vp,
+                buf,
+            );
             return;
         }
         for p in &positions[lo..hi] {
@@ -113,7 +132,7 @@ fn two_stage_cuboid(
             let nz = interval_split(p[2], h, &up, &mut fz);
             for &(k, sz) in &fz[..nz] {
                 for &(by, sy) in &fy[..ny] {
-                    let row = (k * nb + by) * nb;
+                    let row = (k * nb + by) * nb - base;
                     for &(bx, sx) in &fx[..nx] {
                         buf[row + bx] += vp * sx * sy * sz;
                     }
@@ -126,16 +145,17 @@ fn two_stage_cuboid(
     let per = g.cells_per_layer();
     out.par_chunks_mut(per).enumerate().for_each(|(k, layer)| {
         layer.fill(0.0);
+        // Layer k's boxes of each chunk that reaches it.
         let (mut from, mut m): ([&[f64]; BOX_CHUNKS], usize) = ([&[]; BOX_CHUNKS], 0);
         for sums in bufs.iter().filter(|s| s.layers.contains(&k)) {
-            (from[m], m) = (&sums.volume, m + 1);
+            let at = (k - sums.layers.start) * nb * nb;
+            (from[m], m) = (&sums.volume[at..at + nb * nb], m + 1);
         }
         if m == 0 {
             return;
         }
-        let base = k * nb * nb;
-        let (first, rest) = (&from[0][base..base + nb * nb], &from[1..m]);
-        let v = |b: u32| first[b as usize] + rest.iter().map(|r| r[base + b as usize]).sum::<f64>();
+        let (first, rest) = (from[0], &from[1..m]);
+        let v = |b: u32| first[b as usize] + rest.iter().map(|r| r[b as usize]).sum::<f64>();
         // Each cell sums its whole boxes in registers (four running sums), so consecutive boxes of
         // one cell do not wait on each other through memory; then the shared boxes add their shares.
         for (c, out) in layer.iter_mut().enumerate() {
@@ -165,19 +185,28 @@ per_isa!(
     /// `deposit_small_cubes` on the best vector path the CPU has (`simd::per_isa`): the same
     /// operations in the same order (no fused multiply-add), so the same bits.
     fn deposit_small_cubes_on, deposit_paths, deposit_small_cubes,
-    (positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64])
+    (positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, base: usize, vp: f64, buf: &mut [f64])
 );
 
 /// Each particle's cube (side h ≤ the box side and the layer height) onto its 2 × 2 × 2 boxes of
-/// `buf` (layer-major, rows of `nb` boxes): per layer and row the two boxes are neighbours.
+/// `buf` (layer-major, rows of `nb` boxes, the column's box index less `base`): per layer and row
+/// the two boxes are neighbours.
 #[inline(always)]
-fn deposit_small_cubes(positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, vp: f64, buf: &mut [f64]) {
+fn deposit_small_cubes(
+    positions: &[[f64; 3]],
+    across: SplitTwo,
+    up: SplitTwo,
+    nb: usize,
+    base: usize,
+    vp: f64,
+    buf: &mut [f64],
+) {
     for p in positions {
         let ([(x0, wx0), (x1, wx1)], [(y0, wy0), (y1, wy1)], [(k0, wz0), (k1, wz1)]) =
             (across.split(p[0]), across.split(p[1]), up.split(p[2]));
         for (k, wz) in [(k0, vp * wz0), (k1, vp * wz1)] {
             for (by, w) in [(y0, wz * wy0), (y1, wz * wy1)] {
-                let row = (k * nb + by) * nb;
+                let row = (k * nb + by) * nb - base;
                 buf[row + x0] += w * wx0;
                 buf[row + x1] += w * wx1;
             }
@@ -304,8 +333,8 @@ mod two_stage_tests {
         let (across, up) = (SplitTwo::new(&across, h), SplitTwo::new(&up, h));
         let mut best = vec![0.0; bg.nb * bg.nb * g.nz];
         let mut portable = best.clone();
-        deposit_small_cubes_on(&pos, across, up, bg.nb, 1.0, &mut best);
-        deposit_small_cubes(&pos, across, up, bg.nb, 1.0, &mut portable);
+        deposit_small_cubes_on(&pos, across, up, bg.nb, 0, 1.0, &mut best);
+        deposit_small_cubes(&pos, across, up, bg.nb, 0, 1.0, &mut portable);
         assert!(best.iter().zip(&portable).all(|(a, b)| a.to_bits() == b.to_bits()));
         let total: f64 = best.iter().sum();
         assert!((total - pos.len() as f64).abs() < 1e-9, "volume {total}");
