@@ -109,30 +109,14 @@ impl PressureFollow {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Simulation;
-    use crate::case::{Case, PressureForce};
+    use crate::case::PressureForce;
     use crate::coupling::exchange::{angle_of, cyl_to_cart};
-
-    /// The resume tests' bed (1,600 particles, a poured bed, gas sub-cycled), coupled every 6
-    /// DEM steps with the pressure force following the gas.
-    fn case() -> Case {
-        let mut c = super::super::resume_tests::case();
-        c.coupling.interval_steps = 6;
-        c.coupling.pressure_force = PressureForce::GasStep;
-        c
-    }
 
     #[test]
     fn between_couplings_the_pressure_force_moves_by_minus_vp_times_the_change_of_the_gas_gradient() {
-        let c = case();
-        assert!(c.validate().is_ok(), "{:?}", c.validate().errors);
-        let mut a = Simulation::new(c, None).unwrap();
-        while a.steps() < 600 {
-            a.step().unwrap();
-        }
-        // From the same state, one run with the force held and one with it following the gas.
-        let mut b = Simulation::restore(&a.checkpoint()).unwrap();
-        b.st.case.coupling.pressure_force = PressureForce::Held;
+        // The resume tests' bed coupled every 6 DEM steps, from one state at step 600: one run with
+        // the force following the gas (a), one with it held (b).
+        let (mut a, mut b) = super::super::resume_tests::held_and(PressureForce::GasStep, 600);
         a.step().unwrap(); // the coupling at step 600, then one DEM step
         b.step().unwrap();
         let grad_at_coupling = a.st.follow.grad.clone();

@@ -57,31 +57,14 @@ impl PressureMean {
 
 #[cfg(test)]
 mod tests {
-    use super::super::Simulation;
-    use crate::case::{Case, PressureForce};
+    use crate::case::PressureForce;
     use crate::coupling::exchange::{angle_of, cyl_to_cart, fluid_cell};
-
-    /// The resume tests' bed (1,600 particles, a poured bed, gas sub-cycled), coupled every 6
-    /// DEM steps with the interval-mean pressure force.
-    fn case() -> Case {
-        let mut c = super::super::resume_tests::case();
-        c.coupling.interval_steps = 6;
-        c.coupling.pressure_force = PressureForce::IntervalMean;
-        c
-    }
 
     #[test]
     fn a_coupling_gives_the_particles_minus_vp_times_the_mean_gas_gradient_of_the_interval() {
-        let c = case();
-        assert!(c.validate().is_ok(), "{:?}", c.validate().errors);
-        let mut a = Simulation::new(c, None).unwrap();
-        while a.steps() < 606 {
-            a.step().unwrap();
-        }
-        // From the same state one step, whose coupling gives the mean (a) or the gradient of the
-        // moment (b).
-        let mut b = Simulation::restore(&a.checkpoint()).unwrap();
-        b.st.case.coupling.pressure_force = PressureForce::Held;
+        // The resume tests' bed coupled every 6 DEM steps, at step 606 (a coupling next): one run
+        // whose coupling gives the mean (a), one the gradient of the moment (b).
+        let (mut a, mut b) = super::super::resume_tests::held_and(PressureForce::IntervalMean, 606);
         // The gas steps this coupling's catch-up takes, replayed on a copy of the gas: the
         // gradient of the state each starts from, as the gas solver reports it.
         let mut gas = a.gas().unwrap().clone();

@@ -87,6 +87,22 @@ fn resume_with_the_interval_mean_pressure_force_is_bit_identical() {
     resume_is_bit_identical(c);
 }
 
+/// The resume tests' bed coupled every 6 DEM steps with the particles' pressure force `how`, run
+/// to `steps`; and a copy of that state with the force held: two runs from one state.
+pub(super) fn held_and(how: crate::case::PressureForce, steps: u64) -> (Simulation, Simulation) {
+    let mut c = case();
+    c.coupling.interval_steps = 6;
+    c.coupling.pressure_force = how;
+    assert!(c.validate().is_ok(), "{:?}", c.validate().errors);
+    let mut a = Simulation::new(c, None).unwrap();
+    while a.steps() < steps {
+        a.step().unwrap();
+    }
+    let mut b = Simulation::restore(&a.checkpoint()).unwrap();
+    b.st.case.coupling.pressure_force = crate::case::PressureForce::Held;
+    (a, b)
+}
+
 /// Run `case` straight and with a checkpoint and restore at `CUT`: the snapshots and the final
 /// state are the same bits. Returns the snapshots.
 fn resume_is_bit_identical(case: Case) -> Vec<Snapshot> {
