@@ -142,6 +142,10 @@ pub struct Exchange {
     sub_scratch: Vec<[f64; 3]>,
     /// `carry_hints`' cell per particle identity.
     cell_by_id: Vec<u32>,
+    /// The particles' identities in their order at the last call, and the caller's count of
+    /// re-sorts then (`follow_reorder`).
+    hint_ids: Vec<u32>,
+    hint_order: u64,
 }
 
 #[derive(Default)]
@@ -169,6 +173,8 @@ impl Exchange {
             sub_lost: Vec::new(),
             sub_scratch: Vec::new(),
             cell_by_id: Vec::new(),
+            hint_ids: Vec::new(),
+            hint_order: 0,
         }
     }
 
@@ -330,25 +336,37 @@ impl Exchange {
         &self.cell_of
     }
 
-    /// The particles were re-ordered (a DEM re-sort) since the last call: carry each one's cell,
-    /// the next call's hint, to its new place. `old_ids` and `new_ids` hold each place's particle
-    /// identity before and after. Without this the hints belong to other particles and most
-    /// lookups fall back to the full `CylGrid::locate` (≈ 4× the cost).
-    pub fn carry_hints(&mut self, old_ids: &[u32], new_ids: &[u32]) {
-        if old_ids.len() != self.cell_of.len() || new_ids.len() != old_ids.len() {
+    /// Before a call: `order` counts the re-sorts of the particles so far (the DEM's list builds)
+    /// and `ids` holds each place's particle identity now. After a re-sort since the last call,
+    /// each particle's cell, the next call's lookup hint, moves with it to its new place; without
+    /// this the hints belong to other particles and most lookups fall back to the full
+    /// `CylGrid::locate` (≈ 4× the cost).
+    pub fn follow_reorder(&mut self, order: u64, ids: &[u32]) {
+        if order == self.hint_order && ids.len() == self.hint_ids.len() {
             return;
         }
+        let old = std::mem::take(&mut self.hint_ids);
+        self.carry_hints(&old, ids);
+        self.hint_ids = old;
+        self.hint_ids.clear();
+        self.hint_ids.extend_from_slice(ids);
+        self.hint_order = order;
+    }
+
+    /// Carry each particle's cell from its place in `old_ids` to its place in `new_ids` (both a
+    /// permutation of the particles' identities); nothing without a known earlier order.
+    fn carry_hints(&mut self, old_ids: &[u32], new_ids: &[u32]) {
         let n = old_ids.len();
-        let by_id = &mut self.cell_by_id;
-        by_id.clear();
-        by_id.resize(n, 0);
+        if n != self.cell_of.len() || new_ids.len() != n {
+            return;
+        }
+        self.cell_by_id.clear();
+        self.cell_by_id.resize(n, 0);
         for (&id, &c) in old_ids.iter().zip(&self.cell_of) {
-            if let Some(slot) = by_id.get_mut(id as usize) {
-                *slot = c;
-            }
+            self.cell_by_id[id as usize] = c;
         }
         for (c, &id) in self.cell_of.iter_mut().zip(new_ids) {
-            *c = by_id.get(id as usize).copied().unwrap_or(0);
+            *c = self.cell_by_id[id as usize];
         }
     }
 

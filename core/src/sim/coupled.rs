@@ -24,10 +24,6 @@ pub(super) struct Buffers {
     pub cell_grad_p: Vec<[f64; 3]>,
     pub cell_force: Vec<[f64; 3]>,
     pub exchange: Exchange,
-    /// The particles' identities in their order at the exchange's last call, and the DEM's list
-    /// build then: after a re-sort the exchange's cell hints are carried to the new order.
-    pub hint_ids: Vec<u32>,
-    pub hint_build: u64,
     /// The voidage of a frozen bed is computed once.
     pub voidage_fresh: bool,
     /// Drag-voidage sub-layers: their grid (n layers per fluid layer), solid volume and voidage.
@@ -81,8 +77,6 @@ impl Buffers {
             cell_grad_p: vec![[0.0; 3]; cells],
             cell_force: vec![[0.0; 3]; cells],
             exchange: Exchange::new(grid, particles),
-            hint_ids: Vec::new(),
-            hint_build: 0,
             voidage_fresh: false,
             sub: (sublayers > 1).then(|| SubLayers::new(grid, sublayers)),
         }
@@ -171,13 +165,7 @@ impl Simulation {
                 None => DragCells::cells(&self.grid, &b.voidage),
                 Some(s) => DragCells { grid: &s.grid, sublayers: s.n, voidage: &s.voidage },
             };
-            let build = dem.list_builds().0;
-            if build != b.hint_build {
-                b.exchange.carry_hints(&b.hint_ids, dem.ids());
-                b.hint_ids.clear();
-                b.hint_ids.extend_from_slice(dem.ids());
-                b.hint_build = build;
-            }
+            b.exchange.follow_reorder(dem.list_builds().0, dem.ids());
             let (pos, vel, ext) = dem.coupling_views();
             b.exchange.particle_gas_forces(&self.grid, drag, &at, par, (pos, vel), ext, &mut b.cell_force);
         } else {

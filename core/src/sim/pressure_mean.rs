@@ -14,8 +14,7 @@ use crate::cfd::GasSolver;
 use serde::{Deserialize, Serialize};
 
 /// Σ ∇p (Cartesian) per cell of the bed's layers (and two above) over the gas steps since the last
-/// coupling;
-/// travels in the checkpoint (`pressure_mean`).
+/// coupling; travels in the checkpoint (`pressure_mean`).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub(super) struct PressureMean {
     sum: Vec<[f64; 3]>,

@@ -91,7 +91,7 @@ fn two_stage_cuboid(
     // Each chunk clears, fills and hands on only the layers its cubes reach (the particles are
     // in the DEM's z-major cell order, so the chunks are mostly the lower and the upper bed, and
     // the freeboard holds no solid): cubes span [z − h/2, z + h/2], so layers
-    // cell(z_min − h/2) ..= cell(z_max + h/2) of the chunk.
+    // cell(z_min − h/2) ..= cell(z_max + h/2) of the chunk, and one more at each end (below).
     let up = Axis::new(0.0, g.dz, g.nz);
     bufs.par_iter_mut().enumerate().for_each(|(n, sums)| {
         let lo = (n * chunk).min(positions.len());
