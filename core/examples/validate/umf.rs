@@ -10,11 +10,13 @@
 //! `FLUIDBED_UMF="column_mm=44,height_mm=30,seed=1,start=0.36,step=0.02,stages=8"` changes the
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
-//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` or `pressure_mean`, 1 for the case's
-//! `coupling.pressure_force` "gas_step" or "interval_mean", 0 for not). `umf-paper-cells` runs the same sweep with dz = dr,
-//! the drag voidage on 8 sub-layers per cell and the pressure force following the gas.
+//! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` or `pressure_mean`, 1 for the
+//! case's `coupling.pressure_force` "gas_step" or "interval_mean", 0 for the case's own).
+//! `umf-paper-cells` runs the same sweep with dz = dr, the drag voidage on 8 sub-layers per cell
+//! and the pressure force following the gas.
 
 use crate::common::*;
+use fluidbed_core::case::PressureForce;
 use serde_json::json;
 
 /// The sweep and bed, from `FLUIDBED_UMF` over the defaults.
@@ -30,10 +32,8 @@ struct Sweep {
     dz_over_dr: f64,
     /// `coupling.drag_voidage_sublayers` (None: the case's).
     sublayers: Option<u32>,
-    /// `coupling.pressure_force` = "gas_step" (false: the case's).
-    pressure_gas_step: bool,
-    /// `coupling.pressure_force` = "interval_mean" (false: the case's, or gas_step above).
-    pressure_mean: bool,
+    /// `coupling.pressure_force` (None: the case's).
+    pressure_force: Option<PressureForce>,
 }
 
 impl Sweep {
@@ -49,8 +49,7 @@ impl Sweep {
             hold: 0.1,
             dz_over_dr: 0.5,
             sublayers: None,
-            pressure_gas_step: false,
-            pressure_mean: false,
+            pressure_force: None,
         }
     }
 
@@ -70,8 +69,8 @@ impl Sweep {
                 "hold" => s.hold = x,
                 "dz_over_dr" => s.dz_over_dr = x,
                 "sublayers" => s.sublayers = Some(x as u32),
-                "pressure_gas_step" => s.pressure_gas_step = x != 0.0,
-                "pressure_mean" => s.pressure_mean = x != 0.0,
+                "pressure_gas_step" => s.pressure_force = (x != 0.0).then_some(PressureForce::GasStep),
+                "pressure_mean" => s.pressure_force = (x != 0.0).then_some(PressureForce::IntervalMean),
                 _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean)"),
             }
         }
@@ -89,7 +88,8 @@ pub fn run() -> serde_json::Value {
 /// every-step coupling at the interval of 10; docs/VALIDATION.md "U_mf with the paper's cells" and
 /// "The pressure force between couplings").
 pub fn run_paper_cells() -> serde_json::Value {
-    let base = Sweep { dz_over_dr: 1.0, sublayers: Some(8), pressure_gas_step: true, ..Sweep::shipped() };
+    let base =
+        Sweep { dz_over_dr: 1.0, sublayers: Some(8), pressure_force: Some(PressureForce::GasStep), ..Sweep::shipped() };
     sweep(Sweep::from_env(base), "umf-paper-cells", "docs/img/umf_paper_cells.png")
 }
 
@@ -101,11 +101,8 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
         case.grid.dr_m = case.column.diameter_m / 2.0 / 3.0;
         // (the shipped case's voidage: its boxes and cube are set by d, not by the column)
     }
-    if sw.pressure_gas_step {
-        case.coupling.pressure_force = fluidbed_core::case::PressureForce::GasStep;
-    }
-    if sw.pressure_mean {
-        case.coupling.pressure_force = fluidbed_core::case::PressureForce::IntervalMean;
+    if let Some(how) = sw.pressure_force {
+        case.coupling.pressure_force = how;
     }
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;
