@@ -48,7 +48,7 @@ pub fn run() -> Value {
         match crate::slug_rise::finished_at(u) {
             Some(done) => {
                 let p = point(
-                    &format!("44-mm bed, 90 mm settled, U = {u} m/s"),
+                    &format!("44-mm bed, 160 mm settled, U = {u} m/s"),
                     &done.analysis,
                     &format!("docs/img/pressure_oscillation_slug44_U{u}.png"),
                 );
