@@ -24,6 +24,7 @@ const CASES: &[(&str, &str)] = &[
     ("dem-pour.json", include_str!("../../../cases/dem-pour.json")),
     ("packed-bed.json", include_str!("../../../cases/packed-bed.json")),
     ("bubbling-44mm.json", include_str!("../../../cases/bubbling-44mm.json")),
+    ("bubbling-44mm-paper-cells.json", include_str!("../../../cases/bubbling-44mm-paper-cells.json")),
     ("pressure-oscillation-50mm.json", include_str!("../../../cases/pressure-oscillation-50mm.json")),
     ("slugging-50mm-U0.37.json", include_str!("../../../cases/slugging-50mm-U0.37.json")),
     ("slugging-50mm-U0.425.json", include_str!("../../../cases/slugging-50mm-U0.425.json")),
