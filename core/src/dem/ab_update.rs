@@ -1,5 +1,6 @@
 //! The multistep update on flat arrays (PHYSICS.md 7): y ← y + (hb0 f + hb1 f_newer + hb2
-//! f_older), then f_older ← f. `ab_flat` serves velocities and spins; `ab_flat_moved` serves
+//! f_older), then f_older ← f; the past derivatives are stored in single precision
+//! (`forces::PastV3`), read widened to f64. `ab_flat` serves velocities and spins; `ab_flat_moved` serves
 //! positions and also returns the largest |increment| and |new y|, which grow the system's bound
 //! on the displacement since the near-list refresh. With those maxima in the loop the compiler
 //! left it scalar (a redundant second update of x, v and ω cost 14% of a step), so on AVX-512
@@ -11,10 +12,10 @@ use std::arch::x86_64::*;
 
 /// y ← y + (hb0 f + hb1 f_newer + hb2 f_older), f_older ← f (a loop the compiler vectorises).
 #[inline(always)]
-pub(crate) fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) {
+pub(crate) fn ab_flat(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f32], older: &mut [f32]) {
     for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
-        *y += hb[0] * f + hb[1] * f1 + hb[2] * *f2;
-        *f2 = f;
+        *y += hb[0] * f + hb[1] * f1 as f64 + hb[2] * *f2 as f64;
+        *f2 = f as f32;
     }
 }
 
@@ -27,8 +28,8 @@ pub(crate) fn ab_flat_moved<const V: bool>(
     hb: [f64; 3],
     y: &mut [f64],
     f: &[f64],
-    newer: &[f64],
-    older: &mut [f64],
+    newer: &[f32],
+    older: &mut [f32],
 ) -> (f64, f64) {
     let n = y.len();
     assert!(f.len() == n && newer.len() == n && older.len() == n, "arrays of one length");
@@ -40,12 +41,12 @@ pub(crate) fn ab_flat_moved<const V: bool>(
     moved_portable(hb, y, f, newer, older)
 }
 
-fn moved_portable(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
+fn moved_portable(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f32], older: &mut [f32]) -> (f64, f64) {
     let (mut inc_max, mut y_max) = (0.0f64, 0.0f64);
     for (((y, &f), &f1), f2) in y.iter_mut().zip(f).zip(newer).zip(older.iter_mut()) {
-        let inc = hb[0] * f + hb[1] * f1 + hb[2] * *f2;
+        let inc = hb[0] * f + hb[1] * f1 as f64 + hb[2] * *f2 as f64;
         *y += inc;
-        *f2 = f;
+        *f2 = f as f32;
         let (a, b) = (inc.abs(), y.abs());
         inc_max = if a > inc_max { a } else { inc_max };
         y_max = if b > y_max { b } else { y_max };
@@ -54,10 +55,10 @@ fn moved_portable(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: 
 }
 
 /// # Safety
-/// The CPU has avx512f; the four arrays have one length.
+/// The CPU has avx512f and avx512vl; the four arrays have one length.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f")]
-unsafe fn moved_avx512(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], older: &mut [f64]) -> (f64, f64) {
+#[target_feature(enable = "avx512f,avx512vl")]
+unsafe fn moved_avx512(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f32], older: &mut [f32]) -> (f64, f64) {
     let n = y.len();
     let h = hb.map(|c| _mm512_set1_pd(c));
     let (mut inc_max, mut y_max) = (_mm512_setzero_pd(), _mm512_setzero_pd());
@@ -66,12 +67,13 @@ unsafe fn moved_avx512(hb: [f64; 3], y: &mut [f64], f: &[f64], newer: &[f64], ol
         // The tail by masks: its lanes past n load zeros, which leave the maxima alone.
         let m: __mmask8 = if n - k >= 8 { 0xff } else { (1u8 << (n - k)) - 1 };
         let fk = _mm512_maskz_loadu_pd(m, pf.add(k));
-        let (f1, f2) = (_mm512_maskz_loadu_pd(m, pn.add(k)), _mm512_maskz_loadu_pd(m, po.add(k)));
+        let f1 = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(m, pn.add(k)));
+        let f2 = _mm512_cvtps_pd(_mm256_maskz_loadu_ps(m, po.add(k)));
         let inc =
             _mm512_add_pd(_mm512_add_pd(_mm512_mul_pd(h[0], fk), _mm512_mul_pd(h[1], f1)), _mm512_mul_pd(h[2], f2));
         let yk = _mm512_add_pd(_mm512_maskz_loadu_pd(m, py.add(k)), inc);
         _mm512_mask_storeu_pd(py.add(k), m, yk);
-        _mm512_mask_storeu_pd(po.add(k), m, fk);
+        _mm256_mask_storeu_ps(po.add(k), m, _mm512_cvtpd_ps(fk));
         // max(a, b) is a > b ? a : b, so a NaN in a is passed over, as in the portable loop.
         inc_max = _mm512_max_pd(_mm512_abs_pd(inc), inc_max);
         y_max = _mm512_max_pd(_mm512_abs_pd(yk), y_max);
@@ -98,7 +100,8 @@ mod tests {
             if n > 20 {
                 arrays[1][17] = f64::NAN;
             }
-            let (y0, f, f1, f2) = (arrays[0].clone(), &arrays[1], &arrays[2], arrays[3].clone());
+            let narrow = |v: &[f64]| v.iter().map(|&x| x as f32).collect::<Vec<f32>>();
+            let (y0, f, f1, f2) = (arrays[0].clone(), &arrays[1], &narrow(&arrays[2]), narrow(&arrays[3]));
             let (mut ya, mut oa) = (y0.clone(), f2.clone());
             let Some(isa) = Isa::avx512() else {
                 return crate::dem::tests::skip("vector_update_with_maxima_equals_the_portable_one", "no AVX-512");
@@ -107,7 +110,8 @@ mod tests {
             let (mut yb, mut ob) = (y0.clone(), f2.clone());
             let want = moved_portable(hb, &mut yb, f, f1, &mut ob);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert_eq!((bits(&ya), bits(&oa)), (bits(&yb), bits(&ob)), "arrays, n = {n}");
+            let bits32 = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert_eq!((bits(&ya), bits32(&oa)), (bits(&yb), bits32(&ob)), "arrays, n = {n}");
             assert_eq!((got.0.to_bits(), got.1.to_bits()), (want.0.to_bits(), want.1.to_bits()), "maxima, n = {n}");
             let (mut inc_max, mut y_max) = (0.0f64, 0.0f64);
             for k in (0..n).filter(|&k| !f[k].is_nan()) {

@@ -25,14 +25,26 @@ use serde::{Deserialize, Serialize};
 /// Force and n × F_t sums of one particle.
 pub type Acc = [f64; 6];
 
+/// A past derivative as stored: single precision. The multistep update reads it with weights
+/// −16/12 and 5/12 beside the current derivative at full precision, so its rounding (relative
+/// 2⁻²⁴) moves a step by at most 2⁻²⁴·(21/12)·h·max|f|: ~1e-7 of an increment, far under the
+/// contact law's own error (test `free_fall_with_single_precision_history_is_exact_to_1e-7`).
+/// Half the bytes of the history, which the particle pass streams every step.
+pub type PastV3 = [f32; 3];
+
 /// Past derivatives for the multistep scheme, two of each (structure of arrays): velocities
 /// (for x), accelerations (for v), angular accelerations (for ω). `ring` (in the system) says
 /// which slot is the newer one, so a step overwrites the older slot instead of shifting both.
+/// Checkpoints hold them as f64 (the format of earlier builds, which still resume; f32 → f64
+/// → f32 is exact, so a resumed run continues bit for bit).
 #[derive(Clone, Debug, Default, Serialize, Deserialize, PartialEq)]
 pub struct Past {
-    pub v: [Vec<V3>; 2],
-    pub a: [Vec<V3>; 2],
-    pub alpha: [Vec<V3>; 2],
+    #[serde(with = "wide_slots")]
+    pub v: [Vec<PastV3>; 2],
+    #[serde(with = "wide_slots")]
+    pub a: [Vec<PastV3>; 2],
+    #[serde(with = "wide_slots")]
+    pub alpha: [Vec<PastV3>; 2],
 }
 
 impl Past {
@@ -45,6 +57,39 @@ impl Past {
         for s in self.v.iter_mut().chain(&mut self.a).chain(&mut self.alpha) {
             *s = order.iter().map(|&o| s[o as usize]).collect();
         }
+    }
+}
+
+/// A derivative to its stored precision.
+#[inline(always)]
+pub fn narrow(f: V3) -> PastV3 {
+    f.map(|c| c as f32)
+}
+
+/// The two slots of a past derivative in a checkpoint: as `[Vec<[f64; 3]>; 2]` (the same bytes
+/// as earlier builds wrote).
+mod wide_slots {
+    use super::PastV3;
+    use serde::ser::SerializeTuple;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    struct Wide<'a>(&'a [PastV3]);
+    impl Serialize for Wide<'_> {
+        fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+            s.collect_seq(self.0.iter().map(|r| r.map(f64::from)))
+        }
+    }
+
+    pub fn serialize<S: Serializer>(slots: &[Vec<PastV3>; 2], s: S) -> Result<S::Ok, S::Error> {
+        let mut t = s.serialize_tuple(2)?;
+        t.serialize_element(&Wide(&slots[0]))?;
+        t.serialize_element(&Wide(&slots[1]))?;
+        t.end()
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[Vec<PastV3>; 2], D::Error> {
+        let wide = <[Vec<[f64; 3]>; 2]>::deserialize(d)?;
+        Ok(wide.map(|s| s.into_iter().map(|r| r.map(|c| c as f32)).collect()))
     }
 }
 

@@ -5,7 +5,7 @@
 
 use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::{dist2, V3};
-use super::forces::{Acc, Past, Stats};
+use super::forces::{narrow, Acc, Past, PastV3, Stats};
 use super::kernel::{Isa, Kernel};
 use super::walls::{wall_forces, WallList};
 use super::work_split::Sums;
@@ -107,29 +107,32 @@ fn wall_blocks(walls: &mut WallList, n: usize) -> Vec<(&[u32], &mut [[V3; 3]])> 
     out
 }
 
-/// Pass 2 for start-up: accelerations (a, α) of every particle into `out`.
+/// Pass 2 for start-up: accelerations a and α of every particle into `a_out` and `alpha_out`, at
+/// the past derivatives' precision (the start-up step keeps them as the history).
 pub(crate) fn accel_pass<const FR: bool>(
     p: &DemParams,
     (x, v, w): (&[V3], &[V3], &[V3]),
     walls: &mut WallList,
     ext: &[V3],
     sc: Sums,
-    out: &mut [Acc],
+    (a_out, alpha_out): (&mut [PastV3], &mut [PastV3]),
 ) -> Stats {
+    assert!(a_out.len() == x.len() && alpha_out.len() == x.len(), "one output row per particle");
     let wb = wall_blocks(walls, x.len());
-    out.par_chunks_mut(BLOCK)
+    a_out
+        .par_chunks_mut(BLOCK)
+        .zip(alpha_out.par_chunks_mut(BLOCK))
         .zip(wb)
         .enumerate()
-        .map(|(b, (ob, (widx, whist)))| {
-            let r = b * BLOCK..b * BLOCK + ob.len();
+        .map(|(b, ((ab, alb), (widx, whist)))| {
+            let r = b * BLOCK..b * BLOCK + ab.len();
             let (v, w) = (&v[r.clone()], &w[r.clone()]);
-            // SAFETY: initialised rows seen as possibly uninitialised; block_forces writes them all
-            // (with initialised values only).
-            let rows = unsafe { &mut *(ob as *mut [Acc] as *mut [MaybeUninit<Acc>]) };
-            let (ob, st) = block_forces::<FR>(p, r.start, (&x[r], v, w), ext, sc, (widx, whist), rows);
-            for ((o, &vi), &wi) in ob.iter_mut().zip(v).zip(w) {
-                let (a, alpha) = (accel_of(p, o, vi), alpha_of::<FR>(p, o, wi));
-                *o = [a[0], a[1], a[2], alpha[0], alpha[1], alpha[2]];
+            let mut rows = [MaybeUninit::<Acc>::uninit(); BLOCK];
+            let (sums, st) =
+                block_forces::<FR>(p, r.start, (&x[r], v, w), ext, sc, (widx, whist), &mut rows[..ab.len()]);
+            for (l, o) in sums.iter().enumerate() {
+                ab[l] = narrow(accel_of(p, o, v[l]));
+                alb[l] = narrow(alpha_of::<FR>(p, o, w[l]));
             }
             st
         })
@@ -162,8 +165,8 @@ pub(super) struct BlockMotion<'a> {
     pub x: &'a mut [V3],
     pub v: &'a mut [V3],
     pub w: &'a mut [V3],
-    pub newer: [&'a [V3]; 3],
-    pub older: [&'a mut [V3]; 3],
+    pub newer: [&'a [PastV3]; 3],
+    pub older: [&'a mut [PastV3]; 3],
     pub widx: &'a [u32],
     pub whist: &'a mut [[V3; 3]],
 }

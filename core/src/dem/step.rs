@@ -5,7 +5,7 @@
 //! The first step after a start or a change of parameters is Heun's (PHYSICS.md 7).
 
 use super::contact::V3;
-use super::forces::{pair_pass, Acc, Stats};
+use super::forces::{narrow, pair_pass, PastV3, Stats};
 use super::integrator::weights;
 use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
 use super::system::DemSystem;
@@ -122,41 +122,66 @@ impl DemSystem {
 
     /// First step: Heun (Euler predictor, trapezoid corrector; two force evaluations). The
     /// contact histories keep the values of the first evaluation (they are integrated by Euler).
+    /// The derivatives live in the past slots: the first evaluation's in the newer slot (the
+    /// next step's history), the second's in the older (which the next step's AB2 does not read),
+    /// and the corrector adds h/2 (f₁ − f₀) to the predicted state, so the step needs no arrays
+    /// of its own beyond the contact histories' copy.
     pub(super) fn heun<const FR: bool>(&mut self) -> Stats {
         let n = self.x.len();
         let h = self.p.dt;
-        let mut d0: Vec<Acc> = vec![[0.0; 6]; n];
-        let st =
-            accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d0);
-        let (x0, v0, w0) = (self.x.clone(), self.v.clone(), self.w.clone());
+        let newer = 1 - self.ring as usize;
+        let q = &mut self.past;
+        let (a0, a1) = split_slots(&mut q.a, newer);
+        let (al0, al1) = split_slots(&mut q.alpha, newer);
+        let st = accel_pass::<FR>(
+            &self.p,
+            (&self.x, &self.v, &self.w),
+            &mut self.walls,
+            &self.ext,
+            self.sc.sums(),
+            (a0, al0),
+        );
+        let v0 = &mut q.v[newer];
         let nl = &self.near.list;
         let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
-        let step = |y: &V3, f: &[f64], c: f64| [y[0] + c * f[0], y[1] + c * f[1], y[2] + c * f[2]];
+        let step = |y: &mut V3, f: [f64; 3], c: f64| {
+            for k in 0..3 {
+                y[k] += c * f[k];
+            }
+        };
+        let wide = |f: &PastV3| f.map(f64::from);
         for i in 0..n {
-            self.x[i] = step(&x0[i], &v0[i], h);
-            self.v[i] = step(&v0[i], &d0[i][..3], h);
-            self.w[i] = step(&w0[i], &d0[i][3..], h);
+            v0[i] = narrow(self.v[i]);
+            let vi = self.v[i];
+            step(&mut self.x[i], vi, h);
+            step(&mut self.v[i], wide(&a0[i]), h);
+            step(&mut self.w[i], wide(&al0[i]), h);
         }
         pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
-        let mut d1: Vec<Acc> = vec![[0.0; 6]; n];
-        accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), &mut d1);
+        accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), (a1, al1));
         (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
-        let newer = 1 - self.ring as usize;
+        let diff = |f1: &PastV3, f0: &PastV3| [0, 1, 2].map(|k| f1[k] as f64 - f0[k] as f64);
         for i in 0..n {
             let vs = self.v[i];
-            self.x[i] = step(&step(&x0[i], &v0[i], 0.5 * h), &vs, 0.5 * h);
-            self.v[i] = step(&step(&v0[i], &d0[i][..3], 0.5 * h), &d1[i][..3], 0.5 * h);
+            step(&mut self.x[i], [0, 1, 2].map(|k| vs[k] - v0[i][k] as f64), 0.5 * h);
+            step(&mut self.v[i], diff(&a1[i], &a0[i]), 0.5 * h);
             if FR {
-                self.w[i] = step(&step(&w0[i], &d0[i][3..], 0.5 * h), &d1[i][3..], 0.5 * h);
+                step(&mut self.w[i], diff(&al1[i], &al0[i]), 0.5 * h);
             }
-            let q = &mut self.past;
-            q.v[newer][i] = v0[i];
-            q.a[newer][i] = [d0[i][0], d0[i][1], d0[i][2]];
-            q.alpha[newer][i] = [d0[i][3], d0[i][4], d0[i][5]];
         }
         self.ring = newer as u8;
         self.levels = 2;
         Stats { disp2: self.largest_disp2(), ..st }
+    }
+}
+
+/// The (newer, older) slots of a past derivative, `newer` being the slot index of the newer.
+fn split_slots(s: &mut [Vec<PastV3>; 2], newer: usize) -> (&mut [PastV3], &mut [PastV3]) {
+    let [s0, s1] = s;
+    if newer == 0 {
+        (s0, s1)
+    } else {
+        (s1, s0)
     }
 }
 

@@ -9,7 +9,7 @@
 //! buffers and blocks, whichever thread takes them), so every bit of the result is the same.
 
 use super::contact::V3;
-use super::forces::{chunk_pairs_on, ChunkArgs, Past, Scratch, Stats};
+use super::forces::{chunk_pairs_on, ChunkArgs, Past, PastV3, Scratch, Stats};
 use super::kernel::Kernel;
 use super::neighbors::{Hist, NeighborList};
 use super::pair_scatter::PairSum;
@@ -154,7 +154,7 @@ struct Shared {
     x: Raw<V3>,
     v: Raw<V3>,
     w: Raw<V3>,
-    past: [[Raw<V3>; 2]; 3],
+    past: [[Raw<PastV3>; 2]; 3],
     whist: Raw<[V3; 3]>,
     shear: Raw<Hist>,
     touch: Raw<u8>,
