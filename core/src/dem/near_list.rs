@@ -13,6 +13,7 @@
 //! forces bit for bit (the chunk split follows the entry counts, so with several chunks the force
 //! sums may group differently and differ in rounding).
 
+use super::buffers::resize_reused;
 use super::contact::V3;
 use super::neighbors::NeighborList;
 use rayon::prelude::*;
@@ -82,7 +83,7 @@ impl NearList {
         let from_old = matches!(hist, Histories::Near(_));
         let reach2 = (diameter + gap) * (diameter + gap);
         code.clear();
-        code.resize(total_in, 0);
+        resize_reused(code, total_in, 0);
         let mut counts = vec![0u32; n];
         let blocks: Vec<_> = (0..n.div_ceil(BLOCK)).map(|b| b * BLOCK..((b + 1) * BLOCK).min(n)).collect();
         let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
@@ -124,10 +125,10 @@ impl NearList {
             l.offsets.push(l.offsets.last().unwrap() + c);
         }
         let total = l.offsets[n] as usize;
-        self.src.resize(total, 0);
-        l.nbr.resize(total, 0);
-        l.shear.resize(total, [0.0; 3]);
-        l.touch.resize(total, 0);
+        resize_reused(&mut self.src, total, 0);
+        resize_reused(&mut l.nbr, total, 0);
+        resize_reused(&mut l.shear, total, [0.0; 3]);
+        resize_reused(&mut l.touch, total, 0);
         let offsets = &l.offsets;
         let mut work = Vec::with_capacity(blocks.len());
         let (mut s, mut j, mut h, mut t) = (&mut self.src[..], &mut l.nbr[..], &mut l.shear[..], &mut l.touch[..]);

@@ -2,6 +2,7 @@
 //! each with a private force buffer, planned once per neighbour-list build. A checkpoint carries
 //! the plan's cuts, so that a restored run sums its pair forces in the same order.
 
+use super::buffers::resize_reused;
 use super::neighbors::NeighborList;
 use super::pair_scatter::PairSum;
 use rayon::prelude::*;
@@ -172,7 +173,7 @@ impl Scratch {
         assert!(cuts[0] == 0 && cuts[nc] == n && cuts.windows(2).all(|c| c[0] <= c[1]), "chunk cuts {cuts:?}");
         let cut = |c: usize| cuts[c];
         let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
-        owner.resize(total, 0);
+        resize_reused(&mut owner, total, 0);
         // Per chunk, in parallel: check every partner (i < j < n), find the halo end e, and
         // write each entry's row.
         let mut parts = Vec::with_capacity(nc);
@@ -204,7 +205,7 @@ impl Scratch {
             start.push(start[c] + e - a);
         }
         acc.clear();
-        acc.resize(start[nc], PairSum::default());
+        resize_reused(&mut acc, start[nc], PairSum::default());
         (self.bounds, self.start, self.acc, self.owner) = (bounds, start, acc, owner);
     }
 }
