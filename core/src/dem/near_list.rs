@@ -21,11 +21,30 @@ use rayon::prelude::*;
 /// Rows per work block of a refresh (fixed, so results do not depend on the thread count).
 const BLOCK: usize = 1024;
 
-/// The near list and, for each of its entries, the entry of the Verlet list it came from.
+/// The near list. Each entry is matched to the Verlet list's by its partner within the row (a
+/// row lists each partner once, and the near row is a subsequence of the Verlet row).
 #[derive(Clone, Debug, Default, serde::Serialize, serde::Deserialize)]
 pub struct NearList {
     pub list: NeighborList,
-    pub src: Vec<u32>,
+    /// Where checkpoints of earlier builds kept each entry's Verlet-list entry: read and
+    /// dropped, written empty, so that those checkpoints still resume.
+    retired_src: Retired,
+}
+
+/// A field of earlier checkpoints: a list of u32 (written empty, read and dropped).
+#[derive(Clone, Debug, Default)]
+struct Retired;
+
+impl serde::Serialize for Retired {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(std::iter::empty::<u32>())
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Retired {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Retired, D::Error> {
+        <Vec<u32> as serde::Deserialize>::deserialize(d).map(|_| Retired)
+    }
 }
 
 /// Where the contact histories of a selection come from.
@@ -68,10 +87,7 @@ impl NearList {
         let empty = NearList::default();
         let old = match hist {
             Histories::Near(old) => {
-                assert!(
-                    old.list.offsets.len() == n + 1 && old.src.len() == old.list.nbr.len(),
-                    "near list of another list"
-                );
+                assert!(old.list.offsets.len() == n + 1, "near list of another list");
                 assert!(old.list.nbr.len() <= u32::MAX as usize - 2, "list too long");
                 old
             }
@@ -104,7 +120,7 @@ impl NearList {
                 let (mut p, p_end) =
                     if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
                 for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
-                    let matched = p < p_end && old.src[p] as usize == k;
+                    let matched = p < p_end && old.list.nbr[p] == outer.nbr[k];
                     let live = if from_old { matched && old.list.touch[p] != 0 } else { outer.touch[k] != 0 };
                     let xj = x[outer.nbr[k] as usize];
                     let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
@@ -125,24 +141,22 @@ impl NearList {
             l.offsets.push(l.offsets.last().unwrap() + c);
         }
         let total = l.offsets[n] as usize;
-        resize_reused(&mut self.src, total, 0);
         resize_reused(&mut l.nbr, total, 0);
         resize_reused(&mut l.shear, total, [0.0; 3]);
         resize_reused(&mut l.touch, total, 0);
         let offsets = &l.offsets;
         let mut work = Vec::with_capacity(blocks.len());
-        let (mut s, mut j, mut h, mut t) = (&mut self.src[..], &mut l.nbr[..], &mut l.shear[..], &mut l.touch[..]);
+        let (mut j, mut h, mut t) = (&mut l.nbr[..], &mut l.shear[..], &mut l.touch[..]);
         for r in blocks {
             let len = (offsets[r.end] - offsets[r.start]) as usize;
-            let (s0, s1) = std::mem::take(&mut s).split_at_mut(len);
             let (j0, j1) = std::mem::take(&mut j).split_at_mut(len);
             let (h0, h1) = std::mem::take(&mut h).split_at_mut(len);
             let (t0, t1) = std::mem::take(&mut t).split_at_mut(len);
-            (s, j, h, t) = (s1, j1, h1, t1);
-            work.push((entries(&r), s0, j0, h0, t0));
+            (j, h, t) = (j1, h1, t1);
+            work.push((entries(&r), j0, h0, t0));
         }
         let code = &code[..];
-        work.into_par_iter().for_each(|(ks, src, nbr, shear, touch)| {
+        work.into_par_iter().for_each(|(ks, nbr, shear, touch)| {
             let mut e = 0;
             for k in ks {
                 let c = code[k] as usize;
@@ -154,7 +168,7 @@ impl NearList {
                     (1, true) => ([0.0; 3], 0),
                     _ => (old.list.shear[c - 2], old.list.touch[c - 2]),
                 };
-                (src[e], nbr[e], shear[e], touch[e]) = (k as u32, outer.nbr[k], sh, to);
+                (nbr[e], shear[e], touch[e]) = (outer.nbr[k], sh, to);
                 e += 1;
             }
         });

@@ -85,3 +85,41 @@ fn the_coulomb_audit_leaves_the_trajectory_unchanged() {
     });
     assert!(same_state(&audited, &plain), "the audit changed the trajectory");
 }
+
+/// Checkpoints of earlier builds still read: their near list carried each entry's Verlet-list
+/// entry (`src`, now dropped) and their history was double precision (now read into single);
+/// what this build writes reads back unchanged.
+#[test]
+fn the_near_list_and_history_of_earlier_checkpoints_still_read() {
+    use crate::dem::forces::Past;
+    use crate::dem::near_list::NearList;
+    use crate::dem::neighbors::NeighborList;
+    #[derive(serde::Serialize)]
+    struct OldNear {
+        list: NeighborList,
+        src: Vec<u32>,
+    }
+    #[derive(serde::Serialize)]
+    struct OldPast {
+        v: [Vec<[f64; 3]>; 2],
+        a: [Vec<[f64; 3]>; 2],
+        alpha: [Vec<[f64; 3]>; 2],
+    }
+    let list =
+        NeighborList { offsets: vec![0, 2, 2], nbr: vec![1, 2], shear: vec![[0.5; 3], [0.0; 3]], touch: vec![1, 0] };
+    let bytes = bincode::serialize(&OldNear { list: list.clone(), src: vec![0, 3] }).unwrap();
+    let near: NearList = bincode::deserialize(&bytes).expect("an old near list reads");
+    assert_eq!((&near.list.offsets, &near.list.nbr, &near.list.touch), (&list.offsets, &list.nbr, &list.touch));
+    assert_eq!(near.list.shear, list.shear);
+    let again: NearList = bincode::deserialize(&bincode::serialize(&near).unwrap()).unwrap();
+    assert_eq!((again.list.nbr, again.list.shear), (list.nbr, list.shear));
+
+    let g = 0.1f64; // not a binary fraction: the single-precision value is the nearest to it
+    let slot = || [vec![[g, -2.0 * g, 9.81]; 3], vec![[1.0, 0.0, -0.5]; 3]];
+    let bytes = bincode::serialize(&OldPast { v: slot(), a: slot(), alpha: slot() }).unwrap();
+    let past: Past = bincode::deserialize(&bytes).expect("an old history reads");
+    assert_eq!(past.a[0][2], [0.1f32, -0.2, 9.81]);
+    assert_eq!(past.alpha[1][0], [1.0f32, 0.0, -0.5]);
+    let again: Past = bincode::deserialize(&bincode::serialize(&past).unwrap()).unwrap();
+    assert_eq!(again, past, "f32 -> f64 -> f32 keeps every bit");
+}

@@ -6,9 +6,23 @@ use super::energy::random_gas;
 use super::{test_case, with_damping};
 use crate::dem::forces::{pair_pass, Scratch};
 use crate::dem::near_list::{Histories, NearList};
+use crate::dem::neighbors::NeighborList;
 use crate::dem::pair_scatter::PairSum;
 use crate::dem::DemSystem;
 use std::collections::{HashMap, HashSet};
+
+/// The Verlet-list entry of each near-list entry: its row's entry with the same partner.
+fn sources(outer: &NeighborList, near: &NeighborList) -> Vec<u32> {
+    let mut out = Vec::with_capacity(near.nbr.len());
+    for i in 0..near.offsets.len() - 1 {
+        let row = outer.offsets[i] as usize..outer.offsets[i + 1] as usize;
+        for &j in &near.nbr[near.offsets[i] as usize..near.offsets[i + 1] as usize] {
+            let k = row.clone().find(|&k| outer.nbr[k] == j).expect("a near entry is in its Verlet row");
+            out.push(k as u32);
+        }
+    }
+    out
+}
 
 /// Pairs (i < j) listed in the near list now.
 fn near_pairs(s: &DemSystem) -> HashSet<(u32, u32)> {
@@ -89,9 +103,10 @@ fn near_list_pair_pass_equals_the_whole_lists() {
         s.step(); // live histories
     }
     // The whole list with the near list's histories; every other entry not live.
+    let src = sources(&s.outer, &s.near.list);
     let mut outer = s.outer.clone();
     (outer.touch, outer.shear) = (vec![0; outer.nbr.len()], vec![[1.0; 3]; outer.nbr.len()]);
-    for (e, &k) in s.near.src.iter().enumerate() {
+    for (e, &k) in src.iter().enumerate() {
         outer.shear[k as usize] = s.near.list.shear[e];
         outer.touch[k as usize] = s.near.list.touch[e];
     }
@@ -111,21 +126,21 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(f32::to_bits).collect::<Vec<_>>();
     assert!(bits(&on_near) == bits(&on_outer), "forces and torques differ");
     // Every entry left out of the near list does not touch; the kept ones agree exactly.
-    let kept: HashSet<u32> = s.near.src.iter().copied().collect();
+    let kept: HashSet<u32> = src.iter().copied().collect();
     for k in 0..outer.nbr.len() {
         assert!(kept.contains(&(k as u32)) || outer.touch[k] == 0, "entry {k} touches but was left out");
     }
-    for (e, &k) in s.near.src.iter().enumerate() {
+    for (e, &k) in src.iter().enumerate() {
         assert_eq!(near.touch[e], outer.touch[k as usize]);
         assert!(near.shear[e].map(f32::to_bits) == outer.shear[k as usize].map(f32::to_bits), "history of entry {k}");
     }
     // A refresh (with a gap of zero, so only touching or live entries stay) carries every live
     // history of the old near list to the same pair, bit for bit.
     let again = NearList::select(&s.outer, &s.x, d, 0.0, Histories::Near(&s.near));
-    assert!(again.src.len() < s.near.src.len(), "nothing left out");
-    let old: HashMap<u32, usize> = s.near.src.iter().enumerate().map(|(e, &k)| (k, e)).collect();
+    assert!(again.list.nbr.len() < s.near.list.nbr.len(), "nothing left out");
+    let old: HashMap<u32, usize> = src.iter().enumerate().map(|(e, &k)| (k, e)).collect();
     let mut live = 0;
-    for (e, &k) in again.src.iter().enumerate() {
+    for (e, &k) in sources(&s.outer, &again.list).iter().enumerate() {
         let o = old[&k];
         assert_eq!(again.list.nbr[e], s.near.list.nbr[o]);
         assert_eq!(again.list.touch[e], s.near.list.touch[o]);
