@@ -28,7 +28,7 @@ pub type Acc = [f64; 6];
 /// A past derivative as stored: single precision. The multistep update reads it with weights
 /// −16/12 and 5/12 beside the current derivative at full precision, so its rounding (relative
 /// 2⁻²⁴) moves a step by at most 2⁻²⁴·(21/12)·h·max|f|: ~1e-7 of an increment, far under the
-/// contact law's own error (test `free_fall_with_single_precision_history_is_exact_to_1e-7`).
+/// contact law's own error (test `free_fall_with_single_precision_history_is_exact_to_1e_7`).
 /// Half the bytes of the history, which the particle pass streams every step.
 pub type PastV3 = [f32; 3];
 
@@ -66,17 +66,23 @@ pub fn narrow(f: V3) -> PastV3 {
     f.map(|c| c as f32)
 }
 
+/// A stored derivative as the update reads it (exact).
+#[inline(always)]
+pub fn widen(f: PastV3) -> V3 {
+    f.map(f64::from)
+}
+
 /// The two slots of a past derivative in a checkpoint: as `[Vec<[f64; 3]>; 2]` (the same bytes
 /// as earlier builds wrote).
 mod wide_slots {
-    use super::PastV3;
+    use super::{narrow, widen, PastV3};
     use serde::ser::SerializeTuple;
     use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
     struct Wide<'a>(&'a [PastV3]);
     impl Serialize for Wide<'_> {
         fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-            s.collect_seq(self.0.iter().map(|r| r.map(f64::from)))
+            s.collect_seq(self.0.iter().map(|&r| widen(r)))
         }
     }
 
@@ -89,7 +95,7 @@ mod wide_slots {
 
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<[Vec<PastV3>; 2], D::Error> {
         let wide = <[Vec<[f64; 3]>; 2]>::deserialize(d)?;
-        Ok(wide.map(|s| s.into_iter().map(|r| r.map(|c| c as f32)).collect()))
+        Ok(wide.map(|s| s.into_iter().map(narrow).collect()))
     }
 }
 

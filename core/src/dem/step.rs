@@ -5,7 +5,7 @@
 //! The first step after a start or a change of parameters is Heun's (PHYSICS.md 7).
 
 use super::contact::V3;
-use super::forces::{narrow, pair_pass, PastV3, Stats};
+use super::forces::{narrow, pair_pass, widen, PastV3, Stats};
 use super::integrator::weights;
 use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
 use super::system::DemSystem;
@@ -149,24 +149,24 @@ impl DemSystem {
                 y[k] += c * f[k];
             }
         };
-        let wide = |f: &PastV3| f.map(f64::from);
         for i in 0..n {
             v0[i] = narrow(self.v[i]);
             let vi = self.v[i];
             step(&mut self.x[i], vi, h);
-            step(&mut self.v[i], wide(&a0[i]), h);
-            step(&mut self.w[i], wide(&al0[i]), h);
+            step(&mut self.v[i], widen(a0[i]), h);
+            step(&mut self.w[i], widen(al0[i]), h);
         }
         pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
         accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), (a1, al1));
         (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
-        let diff = |f1: &PastV3, f0: &PastV3| [0, 1, 2].map(|k| f1[k] as f64 - f0[k] as f64);
+        // f₁ − f₀, the first evaluation's as stored.
+        let diff = |f1: V3, f0: PastV3| [0, 1, 2].map(|k| f1[k] - f0[k] as f64);
         for i in 0..n {
             let vs = self.v[i];
-            step(&mut self.x[i], [0, 1, 2].map(|k| vs[k] - v0[i][k] as f64), 0.5 * h);
-            step(&mut self.v[i], diff(&a1[i], &a0[i]), 0.5 * h);
+            step(&mut self.x[i], diff(vs, v0[i]), 0.5 * h);
+            step(&mut self.v[i], diff(widen(a1[i]), a0[i]), 0.5 * h);
             if FR {
-                step(&mut self.w[i], diff(&al1[i], &al0[i]), 0.5 * h);
+                step(&mut self.w[i], diff(widen(al1[i]), al0[i]), 0.5 * h);
             }
         }
         self.ring = newer as u8;
