@@ -154,6 +154,10 @@ pub fn run() {
     let mut mean = restore();
     mean.set_pressure_force(fluidbed_core::case::PressureForce::IntervalMean);
     let mut tm = Tally::default();
+    // The gas stepped forward–backward (cfd/forward_backward.rs) at the default interval.
+    let mut fb = restore();
+    fb.set_gas_time_scheme(fluidbed_core::cfd::TimeScheme::ForwardBackward);
+    let mut tfb = Tally::default();
     let (mut ta, mut td, mut tp, mut tl) = (Tally::default(), Tally::default(), Tally::default(), Tally::default());
     let (mut tf, mut tfl) = (Tally::default(), Tally::default());
     for _ in 0..STEPS / ROUND {
@@ -164,6 +168,7 @@ pub fn run() {
         coupled_round(&mut follow, ROUND, &mut tf);
         coupled_round(&mut follow_long, ROUND, &mut tfl);
         coupled_round(&mut mean, ROUND, &mut tm);
+        coupled_round(&mut fb, ROUND, &mut tfb);
     }
     let dt = case.dem.time_step_s;
     let plan = default.plan();
@@ -178,6 +183,7 @@ pub fn run() {
         ("pressure_force_gas_step", &tf),
         (follow_long_name.as_str(), &tfl),
         ("pressure_force_interval_mean", &tm),
+        ("gas_forward_backward", &tfb),
     ];
     for (name, t) in modes {
         println!(
@@ -343,10 +349,12 @@ pub fn micro() {
 
 /// The gas alone from the fluidized state (force and voidage held), 80 ms at multiples of its
 /// estimated stable step (stability.rs, cfl_factor 1): the step where it stops staying bounded.
-pub fn gas_dt() {
+pub fn gas_dt(scheme: fluidbed_core::cfd::TimeScheme) {
     let case = shipped_case("bubbling-44mm.json");
     let sim = Simulation::restore(&state_at(&case, FLUIDIZED_AT_S, "bubbling-44mm")).expect("state");
-    let base = sim.gas().expect("gas");
+    let mut base = sim.gas().expect("gas").clone();
+    base.set_time_scheme(scheme);
+    let base = &base;
     let limit = base.stable_dt() / base.params().cfl_factor;
     let span = 0.08;
     for k in [0.9, 1.0, 1.03, 1.06, 1.1, 1.2] {

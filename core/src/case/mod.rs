@@ -392,6 +392,11 @@ pub struct Gas {
     /// grows as 1/f and the density stays within Δp/(f a)² of ρ_out.
     #[serde(default = "d_acoustic_speed_factor")]
     pub acoustic_speed_factor: f64,
+    /// Time scheme of the gas: "ab3" (the paper's, PHYSICS.md 7) or "forward_backward" (the
+    /// acoustic terms forward–backward, the rest AB3: a stable step 2.76× longer;
+    /// docs/VALIDATION.md "Forward–backward gas step").
+    #[serde(default, skip_serializing_if = "crate::cfd::TimeScheme::is_ab3")]
+    pub time_scheme: crate::cfd::TimeScheme,
 }
 
 impl Default for Gas {
@@ -410,6 +415,7 @@ impl Default for Gas {
             drag_voidage_min: d_eps_min(),
             cfl_factor: d_cfl(),
             acoustic_speed_factor: d_acoustic_speed_factor(),
+            time_scheme: Default::default(),
         }
     }
 }

@@ -75,6 +75,7 @@
 
 mod ab3;
 mod boundary;
+mod forward_backward;
 mod geometry;
 mod mass_budget;
 mod params;
@@ -93,7 +94,7 @@ pub use ab3::{ab2_weights, ab3_weights, AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
 pub use boundary::{outlet_density_change, ramped_superficial_velocity};
 pub use geometry::{horizontal_inverse_spacing, FaceGeometry, HFace, Neighbour};
 pub use mass_budget::{MassBalance, MassBudget};
-pub use params::{GasParams, Outlet};
+pub use params::{GasParams, Outlet, TimeScheme};
 pub use rhs::FACE_FLUX_RATE;
 pub use smart::smart_face;
 pub use solver::GasSolver;

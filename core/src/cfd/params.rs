@@ -26,3 +26,21 @@ pub struct GasParams {
     pub cfl_factor: f64,
     pub outlet: Outlet,
 }
+
+/// How the gas steps in time (`gas.time_scheme`; forward_backward.rs).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, schemars::JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum TimeScheme {
+    /// The paper's: Heun → AB2 → AB3 on the whole right-hand side (PHYSICS.md 7).
+    #[default]
+    Ab3,
+    /// Forward–backward for the acoustic terms (the pressure force forward, the mass fluxes of the
+    /// new momentum backward), AB3 for the rest: a stable step 2/0.7236 = 2.76× AB3's.
+    ForwardBackward,
+}
+
+impl TimeScheme {
+    pub fn is_ab3(&self) -> bool {
+        *self == TimeScheme::Ab3
+    }
+}

@@ -3,9 +3,10 @@
 
 use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::{outlet_layer, OutletGeometry};
+use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
 use super::mass_budget::{MassBalance, MassBudget};
-use super::params::{GasParams, Outlet};
+use super::params::{GasParams, Outlet, TimeScheme};
 use super::rhs::{
     drag_coefficient, drag_weighted_face_pressure, inlet_face_pressure, net_mass_inflow, top_face_pressure, Primitives,
     RhsInput,
@@ -81,6 +82,10 @@ pub struct GasSolver {
     ramp: Option<VoidageRamp>,
     /// Per cell (p, β/ε², εu) for `exchange_fields`, which reads each cell's several times.
     face_inputs: Vec<FaceInputs>,
+    /// The time scheme (`gas.time_scheme`; set from the case, also on restore).
+    scheme: TimeScheme,
+    /// d(ρε)/dt of the forward–backward step's mass pass.
+    mass_rate: Vec<f64>,
 }
 
 /// What the face pressures of `pressure_gradient_cyl` read of a cell: p, β/ε² and εu (Cartesian).
@@ -125,6 +130,7 @@ impl GasSolver {
             hist_face: Default::default(),
         };
         let mut s = GasSolver::from_state(st, grid);
+        s.scheme = g.time_scheme;
         s.anchor_pressure(g.outlet_pressure_pa);
         for c in 0..n {
             let rho = s.hydrostatic_density(c);
@@ -156,6 +162,8 @@ impl GasSolver {
             budget: MassBudget::default(),
             ramp: None,
             face_inputs: Vec::new(),
+            scheme: TimeScheme::Ab3,
+            mass_rate: vec![0.0; n],
             grid,
         }
     }
@@ -188,6 +196,17 @@ impl GasSolver {
     }
     /// Run parallel right-hand sides as one team of threads when the pool is free for one (default
     /// on); off, as four parallel loops (the same bits; for benchmarks).
+    /// Recount the steps taken (`Simulation::set_gas_time_scheme`: the count of the new step's length).
+    pub fn set_steps(&mut self, steps: u64) {
+        self.st.steps = steps;
+    }
+    /// The time scheme (a checkpoint's comes from its case).
+    pub fn set_time_scheme(&mut self, scheme: TimeScheme) {
+        self.scheme = scheme;
+    }
+    pub fn time_scheme(&self) -> TimeScheme {
+        self.scheme
+    }
     pub fn set_team(&mut self, on: bool) {
         self.team = on;
     }
@@ -389,6 +408,7 @@ impl GasSolver {
                 g.n0,
                 self.geo.max_laplacian_factor,
                 p.cfl_factor,
+                self.scheme,
             ));
         }
         dt
@@ -479,10 +499,18 @@ impl GasSolver {
             r.at(self.st.time, &mut self.st.eps);
         }
         self.start_mass_budget();
-        if self.st.hist_len > 0 && self.parallel && self.team && fits(self.grid.nz, rayon::current_num_threads()) {
+        let forward_backward = self.scheme == TimeScheme::ForwardBackward;
+        if (self.st.hist_len > 0 || forward_backward)
+            && self.parallel
+            && self.team
+            && fits(self.grid.nz, rayon::current_num_threads())
+        {
             if let Some(_team) = TeamLock::try_take() {
                 return self.team_step(dt);
             }
+        }
+        if forward_backward {
+            return self.forward_backward_step(dt);
         }
         let t = self.st.time;
         self.q_old.copy_from_slice(&self.st.q);
@@ -551,6 +579,75 @@ impl GasSolver {
         self.st.steps += 1;
     }
 
+    /// One forward–backward step (forward_backward.rs): the momentum's other terms by AB1 → AB2 →
+    /// AB3 from their own history, the pressure force and the face corrections forward, then the
+    /// mass from the new fluxes.
+    fn forward_backward_step(&mut self, dt: f64) {
+        let t = self.st.time;
+        self.q_old.copy_from_slice(&self.st.q);
+        self.face_old.copy_from_slice(&self.st.face_flux);
+        let newest = (self.st.head + 1) % 3;
+        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
+        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        self.rhs_into(t, &mut f_new, &mut g_new);
+        without_pressure_force(&mut f_new, &self.st.eps, &self.prim.view());
+        let hl = self.st.hist_len;
+        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
+        {
+            let (q, q0) = (self.st.q.as_flattened_mut(), self.q_old.as_flattened());
+            let h = &self.st.hist;
+            match hl {
+                0 => combine(q, q0, &[f_new.as_flattened()], &[dt]),
+                1 => {
+                    combine(q, q0, &[f_new.as_flattened(), h[i1].as_flattened()], &ab2_weights(dt, h1).map(|w| w * dt))
+                }
+                _ => combine(
+                    q,
+                    q0,
+                    &[f_new.as_flattened(), h[i1].as_flattened(), h[i2].as_flattened()],
+                    &ab3_weights(dt, h1, h2).map(|w| w * dt),
+                ),
+            }
+        }
+        add_pressure_force(&mut self.st.q, &self.st.eps, &self.prim.view(), dt);
+        combine(&mut self.st.face_flux, &self.face_old, &[&g_new], &[dt]);
+        let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
+        let inp = RhsInput {
+            geo: &self.geo,
+            params: &self.st.params,
+            per,
+            nz,
+            dz: self.grid.dz,
+            eps: &self.st.eps,
+            force: &self.st.force,
+            face_flux: &self.st.face_flux,
+            time: t,
+        };
+        let pr = self.prim.view();
+        for k in 0..nz - 1 {
+            axial_mass_faces(&inp, &self.st.q, &pr, k, &mut self.axial[k * per..(k + 1) * per]);
+        }
+        for k in 0..nz {
+            let qk = &self.st.q[k * per..(k + 1) * per];
+            mass_layer(&inp, qk, &pr, &self.axial, k, &mut self.mass_rate[k * per..(k + 1) * per]);
+        }
+        for (s, (s0, r)) in self.st.q.iter_mut().zip(self.q_old.iter().zip(&self.mass_rate)) {
+            s[0] = s0[0] + dt * r;
+        }
+        self.apply_outlet(dt);
+        let net_new = self.net_inflow(t);
+        self.budget.net += dt * net_new;
+        self.budget.hist[newest] = net_new;
+        self.st.hist[newest] = f_new;
+        self.st.hist_face[newest] = g_new;
+        self.st.head = newest;
+        self.st.hist_h = [dt, h1];
+        self.st.hist_len = (hl + 1).min(3);
+        self.st.time = t + dt;
+        self.st.steps += 1;
+    }
+
     /// `step` for AB2/AB3 as one team (team_step.rs); the caller holds the pool's `TeamLock`.
     fn team_step(&mut self, dt: f64) {
         let newest = (self.st.head + 1) % 3;
@@ -559,12 +656,18 @@ impl GasSolver {
         let hl = self.st.hist_len;
         let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
+        let ab1 = [dt];
         let ab2 = ab2_weights(dt, h1).map(|w| w * dt);
         let ab3 = ab3_weights(dt, h1, h2).map(|w| w * dt);
         let (h, hf) = (&self.st.hist, &self.st.hist_face);
         let two = [&h[i1][..], &h[i2][..]];
         let two_face = [&hf[i1][..], &hf[i2][..]];
-        let (weights, m): (&[f64], usize) = if hl == 1 { (&ab2, 1) } else { (&ab3, 2) };
+        let forward_backward = self.scheme == TimeScheme::ForwardBackward;
+        let (weights, m): (&[f64], usize) = match hl {
+            0 => (&ab1, 0),
+            1 => (&ab2, 1),
+            _ => (&ab3, 2),
+        };
         let (past, past_face) = (&two[..m], &two_face[..m]);
         let inp = StepInput {
             geo: &self.geo,
@@ -576,6 +679,7 @@ impl GasSolver {
             time: self.st.time,
             dt,
             weights,
+            forward_backward,
             past,
             past_face,
         };
@@ -588,12 +692,14 @@ impl GasSolver {
             rhs_face: &mut g_new,
             prim: &mut self.prim,
             axial: &mut self.axial,
+            mass_rate: &mut self.mass_rate,
         };
         team_step(&inp, s);
         // The team's primitives and axial faces are those of this step's right-hand side.
         let net_new = self.net_inflow(self.st.time);
         let bh = self.budget.hist;
         self.budget.net += match hl {
+            _ if forward_backward => dt * net_new,
             1 => ab2[0] * net_new + ab2[1] * bh[i1],
             _ => ab3[0] * net_new + ab3[1] * bh[i1] + ab3[2] * bh[i2],
         };

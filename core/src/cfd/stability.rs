@@ -13,10 +13,14 @@
 //! of number θ = kδ the frequency² (a/δ)²[sin²θ + 4s₀ sin⁴(θ/2)], at most (a/δ)²/(1 − s₀) for s₀ ≤ ½.
 //! Viscous spectral radius of the compact Laplacian with ν = (4μ/3 + L)/ρ:
 //!   λ_v = 2ν·max_c Σ_f (|S_f|/δ_f)/V
-//! and dt = cfl·1/(λ_c/0.7236 + λ_v/(6/11)), the min over cells.
+//! and dt = cfl·1/(λ_c/0.7236 + λ_v/(6/11)), the min over cells. With the forward–backward scheme
+//! (forward_backward.rs) the acoustic part's bound is ωΔt ≤ 2 instead of 0.7236:
+//! dt = cfl·1/(λ_a/2 + λ_u/0.7236 + λ_v/(6/11)), λ_a the acoustic and λ_u the convective part of λ_c.
 
 use super::ab3::{AB3_IMAGINARY_LIMIT, AB3_REAL_LIMIT};
+use super::forward_backward::FB_ACOUSTIC_LIMIT;
 use super::geometry::{horizontal_inverse_spacing, FaceGeometry};
+use super::params::TimeScheme;
 use super::rhs::FACE_FLUX_RATE;
 use crate::case::Case;
 use crate::grid::CylGrid;
@@ -34,12 +38,17 @@ pub fn cell_stable_dt(
     n0: usize,
     laplacian_factor: f64,
     cfl: f64,
+    scheme: TimeScheme,
 ) -> f64 {
     let a = a / (1.0 - FACE_FLUX_RATE).sqrt();
     let h = horizontal_inverse_spacing(dr, n0);
-    let lam_c = u_h * h + u_z / dz + a * (h * h + 1.0 / (dz * dz)).sqrt();
+    let (lam_u, lam_a) = (u_h * h + u_z / dz, a * (h * h + 1.0 / (dz * dz)).sqrt());
     let lam_v = 2.0 * nu * laplacian_factor;
-    cfl / (lam_c / AB3_IMAGINARY_LIMIT + lam_v / AB3_REAL_LIMIT)
+    let acoustic_limit = match scheme {
+        TimeScheme::Ab3 => AB3_IMAGINARY_LIMIT,
+        TimeScheme::ForwardBackward => FB_ACOUSTIC_LIMIT,
+    };
+    cfl / (lam_a / acoustic_limit + lam_u / AB3_IMAGINARY_LIMIT + lam_v / AB3_REAL_LIMIT)
 }
 
 /// The stable gas step a case's inlet flow allows before it runs: gas at the outlet density,
@@ -65,5 +74,5 @@ pub fn case_stable_time_step(case: &Case) -> Option<f64> {
     let geo = FaceGeometry::new(&CylGrid::new(radius, 2.0 * dz, dr, dz, n0));
     let u = g.superficial_velocity_m_s.abs() / g.inlet_voidage;
     let nu = (4.0 / 3.0 * g.viscosity_pa_s + g.bulk_viscosity_pa_s) / rho;
-    Some(cell_stable_dt(u, u, a, nu, dr, dz, n0, geo.max_laplacian_factor, g.cfl_factor))
+    Some(cell_stable_dt(u, u, a, nu, dr, dz, n0, geo.max_laplacian_factor, g.cfl_factor, g.time_scheme))
 }

@@ -9,6 +9,7 @@
 
 use super::ab3::combine;
 use super::boundary::{outlet_layer, OutletGeometry};
+use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
 use super::params::{GasParams, Outlet};
 use super::rhs::{PrimView, Primitives, RhsInput};
@@ -26,7 +27,10 @@ pub(super) struct StepInput<'a> {
     pub time: f64,
     pub dt: f64,
     /// The AB weights times the step: of the new right-hand side, then of `past` (one or two).
+    /// With `forward_backward` they step the momentum's terms other than the pressure force.
     pub weights: &'a [f64],
+    /// The forward–backward step (forward_backward.rs) instead of AB on the whole right-hand side.
+    pub forward_backward: bool,
     pub past: &'a [&'a [[f64; 4]]],
     pub past_face: &'a [&'a [f64]],
 }
@@ -42,6 +46,8 @@ pub(super) struct StepState<'a> {
     pub rhs_face: &'a mut [f64],
     pub prim: &'a mut Primitives,
     pub axial: &'a mut [[f64; 7]],
+    /// d(ρε)/dt of the forward–backward step's mass pass (one row per cell).
+    pub mass_rate: &'a mut [f64],
 }
 
 /// Tests only: team steps run (to check that a test took this path).
@@ -59,7 +65,7 @@ pub(super) fn fits(nz: usize, threads: usize) -> bool {
 pub(super) fn team_step(inp: &StepInput, s: StepState) {
     let (per, nz, nf) = (inp.outlet.per, inp.nz, inp.geo.faces.len());
     let n = per * nz;
-    let StepState { q, face, q_old, face_old, rhs, rhs_face, prim, axial } = s;
+    let StepState { q, face, q_old, face_old, rhs, rhs_face, prim, axial, mass_rate } = s;
     let team = rayon::current_num_threads();
     assert!(fits(nz, team), "{nz} layers for a team of {team}");
     let pr = [&mut prim.ux, &mut prim.uy, &mut prim.uz, &mut prim.p, &mut prim.beta, &mut prim.beta_over_eps2];
@@ -76,6 +82,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
     rhs_face[(nz - 1) * per..n].fill(0.0);
     let (q, face, q_old, face_old) = (Raw::new(q), Raw::new(face), Raw::new(q_old), Raw::new(face_old));
     let (rhs, rhs_face, axial) = (Raw::new(rhs), Raw::new(rhs_face), Raw::new(axial));
+    let mass_rate = Raw::new(mass_rate);
     let barrier = SpinBarrier::new(team);
     #[cfg(test)]
     TEAM_STEPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -166,22 +173,33 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
             if !barrier.wait() {
                 return;
             }
-            // The AB update of the own rows: y = y_old + Σ w_i f_i.
-            let w = inp.weights;
-            unsafe {
-                let (y, y0, f) = (q.part(c0, c1), q_old.view(c0, c1), rhs.view(c0, c1));
-                let mut fs: [&[f64]; 3] = [f.as_flattened(), &[], &[]];
-                for (i, h) in inp.past.iter().enumerate() {
-                    fs[i + 1] = h[c0..c1].as_flattened();
+            if inp.forward_backward {
+                // SAFETY: as above; the mass passes read the momentum and F of other threads' rows
+                // only after the barrier that follows their update.
+                let rows = Rows { k: (k0, k1), faces: (f0, f1) };
+                let prim = [ux, uy, uz, p, beta, bz, div, gx, gy, gz];
+                let arrays = FbArrays { q, q_old, rhs, mass_rate, face, face_old, rhs_face, axial, prim };
+                if !unsafe { forward_backward_rows(inp, &arrays, &barrier, rows) } {
+                    return;
                 }
-                combine(y.as_flattened_mut(), y0.as_flattened(), &fs[..w.len()], w);
-                for (lo, hi) in [(c0, c1), (f0, f1)] {
-                    let (y, y0, f) = (face.part(lo, hi), face_old.view(lo, hi), rhs_face.view(lo, hi));
-                    let mut fs: [&[f64]; 3] = [f, &[], &[]];
-                    for (i, h) in inp.past_face.iter().enumerate() {
-                        fs[i + 1] = &h[lo..hi];
+            } else {
+                // The AB update of the own rows: y = y_old + Σ w_i f_i.
+                let w = inp.weights;
+                unsafe {
+                    let (y, y0, f) = (q.part(c0, c1), q_old.view(c0, c1), rhs.view(c0, c1));
+                    let mut fs: [&[f64]; 3] = [f.as_flattened(), &[], &[]];
+                    for (i, h) in inp.past.iter().enumerate() {
+                        fs[i + 1] = h[c0..c1].as_flattened();
                     }
-                    combine(y, y0, &fs[..w.len()], w);
+                    combine(y.as_flattened_mut(), y0.as_flattened(), &fs[..w.len()], w);
+                    for (lo, hi) in [(c0, c1), (f0, f1)] {
+                        let (y, y0, f) = (face.part(lo, hi), face_old.view(lo, hi), rhs_face.view(lo, hi));
+                        let mut fs: [&[f64]; 3] = [f, &[], &[]];
+                        for (i, h) in inp.past_face.iter().enumerate() {
+                            fs[i + 1] = &h[lo..hi];
+                        }
+                        combine(y, y0, &fs[..w.len()], w);
+                    }
                 }
             }
             if t + 1 == nt && inp.params.outlet == Outlet::Characteristic {
@@ -217,4 +235,84 @@ fn rhs_input<'a>(inp: &StepInput<'a>, face_flux: &'a [f64]) -> RhsInput<'a> {
 unsafe fn full_view<'a>(f: [Raw<f64>; 10], n: usize) -> PrimView<'a> {
     let [ux, uy, uz, p, beta, beta_over_eps2, div, gx, gy, gz] = f.map(|r| r.view(0, n));
     PrimView { ux, uy, uz, p, beta, beta_over_eps2, div, gx, gy, gz }
+}
+
+/// A thread's block: its layers k0..k1 and its horizontal-face rows f0..f1.
+struct Rows {
+    k: (usize, usize),
+    faces: (usize, usize),
+}
+
+/// The team's arrays that the forward–backward update reads and writes.
+struct FbArrays {
+    q: Raw<[f64; 4]>,
+    q_old: Raw<[f64; 4]>,
+    rhs: Raw<[f64; 4]>,
+    mass_rate: Raw<f64>,
+    face: Raw<f64>,
+    face_old: Raw<f64>,
+    rhs_face: Raw<f64>,
+    axial: Raw<[f64; 7]>,
+    prim: [Raw<f64>; 10],
+}
+
+/// The forward–backward update of a thread's rows (forward_backward.rs): the momentum (its other
+/// terms by the AB weights, the pressure force forward) and F forward; after a barrier the axial
+/// faces' new ṁ above the own layers; after another the own layers' mass. False if the team failed.
+///
+/// # Safety
+/// As `team_step`'s phases: the thread writes only its own rows, and reads other threads' rows of
+/// q (momentum), F and the axial ṁ only after the barrier that follows their writes; the
+/// primitives are not written.
+unsafe fn forward_backward_rows(inp: &StepInput, a: &FbArrays, barrier: &SpinBarrier, rows: Rows) -> bool {
+    let (per, nz, nf) = (inp.outlet.per, inp.nz, inp.geo.faces.len());
+    let n = per * nz;
+    let ((k0, k1), (f0, f1)) = (rows.k, rows.faces);
+    let (c0, c1) = (k0 * per, k1 * per);
+    let pr = full_view(a.prim, n);
+    {
+        let (f, e) = (a.rhs.part(c0, c1), &inp.eps[c0..c1]);
+        let own = PrimView { gx: &pr.gx[c0..c1], gy: &pr.gy[c0..c1], gz: &pr.gz[c0..c1], ..pr };
+        without_pressure_force(f, e, &own);
+        let w = inp.weights;
+        let (y, y0) = (a.q.part(c0, c1), a.q_old.view(c0, c1));
+        let mut fs: [&[f64]; 3] = [a.rhs.view(c0, c1).as_flattened(), &[], &[]];
+        for (i, h) in inp.past.iter().enumerate() {
+            fs[i + 1] = h[c0..c1].as_flattened();
+        }
+        combine(y.as_flattened_mut(), y0.as_flattened(), &fs[..w.len()], w);
+        add_pressure_force(y, e, &own, inp.dt);
+        for (lo, hi) in [(c0, c1), (f0, f1)] {
+            let (y, y0, f) = (a.face.part(lo, hi), a.face_old.view(lo, hi), a.rhs_face.view(lo, hi));
+            combine(y, y0, &[f], &[inp.dt]);
+        }
+    }
+
+    if !barrier.wait() {
+        return false;
+    }
+    let nface = n + nz * nf;
+    {
+        let (rhs_in, qv) = (rhs_input(inp, a.face.view(0, nface)), a.q.view(0, n));
+        let ka = k1.min(nz - 1);
+        for k in k0..ka {
+            axial_mass_faces(&rhs_in, qv, &pr, k, a.axial.part(k * per, (k + 1) * per));
+        }
+    }
+    if !barrier.wait() {
+        return false;
+    }
+    {
+        // Only the own layers' q is read here: other threads write theirs meanwhile.
+        let (rhs_in, ax) = (rhs_input(inp, a.face.view(0, nface)), a.axial.view(0, n));
+        for k in k0..k1 {
+            let qk = a.q.view(k * per, (k + 1) * per);
+            mass_layer(&rhs_in, qk, &pr, ax, k, a.mass_rate.part(k * per, (k + 1) * per));
+        }
+    }
+    let (y, y0, r) = (a.q.part(c0, c1), a.q_old.view(c0, c1), a.mass_rate.view(c0, c1));
+    for (s, (s0, r)) in y.iter_mut().zip(y0.iter().zip(r)) {
+        s[0] = s0[0] + inp.dt * r;
+    }
+    true
 }

@@ -132,6 +132,10 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
     let dem = bincode::deserialize(section("dem")?).map_err(|e| refuse("dem", e.to_string()))?;
     let mut gas: Option<crate::cfd::GasSolver> =
         bincode::deserialize(section("gas")?).map_err(|e| refuse("gas", e.to_string()))?;
+    // The gas's time scheme is the case's (the gas section holds its state only).
+    if let (Some(g), Some(gc)) = (gas.as_mut(), case.gas.as_ref()) {
+        g.set_time_scheme(gc.time_scheme);
+    }
     // A checkpoint from before the gas mass budget starts it afresh at the resumed state.
     if let Some(body) = sections.get("gas_mass_budget") {
         let budget: Option<crate::cfd::MassBudget> =

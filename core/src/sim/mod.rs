@@ -183,6 +183,23 @@ impl Simulation {
         self.st.case.coupling.interval_steps = steps.max(1);
         self.st.plan.coupling_interval = steps.max(1) as u64;
     }
+    /// The gas's time scheme from the next gas step on, with the plan's gas step made the new
+    /// scheme's stable step at the inlet flow (benchmarks compare both schemes from one state).
+    pub fn set_gas_time_scheme(&mut self, scheme: crate::cfd::TimeScheme) {
+        let Some(g) = self.st.case.gas.as_mut() else { return };
+        g.time_scheme = scheme;
+        let inflow = crate::cfd::case_stable_time_step(&self.st.case).unwrap_or(f64::INFINITY);
+        if let Some(gas) = self.st.gas.as_mut() {
+            gas.set_time_scheme(scheme);
+            let stable = gas.stable_dt().min(inflow);
+            self.st.plan = Plan::for_case(&self.st.case, self.st.dem.len(), Some(stable));
+            // `sync_gas` counts gas steps of the plan's length: recount the steps taken in it.
+            if let Some(dt_g) = self.st.plan.gas_dt_s {
+                let dt = self.st.case.dem.time_step_s;
+                gas.set_steps((self.st.steps as f64 * dt / dt_g - 1e-9).ceil().max(0.0) as u64);
+            }
+        }
+    }
     /// How the gas's voidage moves between couplings from the next coupling on (the trade-off
     /// bench compares both from one state).
     pub fn set_gas_voidage(&mut self, how: crate::case::GasVoidage) {

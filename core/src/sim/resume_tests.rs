@@ -71,6 +71,14 @@ fn resume_with_the_gas_voidage_interpolated_or_extrapolated_is_bit_identical() {
 }
 
 #[test]
+fn resume_with_the_gas_stepped_forward_backward_is_bit_identical() {
+    // The checkpoint's gas holds no scheme: the resumed gas takes it from the checkpoint's case.
+    let mut c = case();
+    c.gas.as_mut().unwrap().time_scheme = crate::cfd::TimeScheme::ForwardBackward;
+    resume_is_bit_identical(c);
+}
+
+#[test]
 fn resume_with_the_pressure_force_following_the_gas_is_bit_identical() {
     // The cut falls between couplings, where each particle's −V_p∇p has moved with the gas since
     // the coupling; the checkpoint carries the cells and the gradients it moves from.

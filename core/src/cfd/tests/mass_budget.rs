@@ -9,7 +9,7 @@ use crate::team::solver_pool;
 
 /// A 10-layer column with a bed-like voidage in its lower half, a drag-like force, a swirling,
 /// rising flow and the inflow ramping up.
-fn fed_bed(outlet: Outlet) -> GasSolver {
+pub(super) fn fed_bed(outlet: Outlet) -> GasSolver {
     let gas =
         Gas { superficial_velocity_m_s: 0.6, ramp_time_s: 0.002, bulk_viscosity_pa_s: 1e-4, ..Default::default() };
     let mut s = solver(gas, 9.81, 3, 0.004, 10, 0.004);
@@ -40,7 +40,7 @@ fn bed_voidage(s: &GasSolver, step: usize) -> Vec<f64> {
 }
 
 /// Steps `s` with a changing voidage; the largest |budget error| seen, checked every step.
-fn run(s: &mut GasSolver, steps: usize, from: usize) -> f64 {
+pub(super) fn run(s: &mut GasSolver, steps: usize, from: usize) -> f64 {
     let dt = 0.8 * s.stable_dt();
     let mut worst = 0.0f64;
     for n in from..from + steps {

@@ -2,6 +2,7 @@
 
 mod acoustics;
 mod conservation;
+mod forward_backward;
 mod freeboard;
 mod hydrostatic;
 mod layer_pressure;

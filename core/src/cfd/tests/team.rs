@@ -7,7 +7,7 @@ use crate::team::solver_pool;
 use std::sync::atomic::Ordering;
 
 /// A 8-layer column with a bed-like voidage, a drag-like force and a swirling, rising flow.
-fn stirred_bed(outlet: Outlet) -> GasSolver {
+pub(super) fn stirred_bed(outlet: Outlet) -> GasSolver {
     let gas = Gas { superficial_velocity_m_s: 0.4, bulk_viscosity_pa_s: 1e-4, ..Default::default() };
     let mut s = solver(gas, 9.81, 3, 0.004, 8, 0.004);
     s.set_outlet(outlet);
@@ -27,7 +27,7 @@ fn stirred_bed(outlet: Outlet) -> GasSolver {
     s
 }
 
-fn state_bits(s: &GasSolver) -> Vec<u64> {
+pub(super) fn state_bits(s: &GasSolver) -> Vec<u64> {
     let n = s.grid().num_cells();
     (0..n).flat_map(|c| [s.density(c)].into_iter().chain(s.velocity_xyz(c))).map(f64::to_bits).collect()
 }
