@@ -613,17 +613,7 @@ impl GasSolver {
         add_pressure_force(&mut self.st.q, &self.st.eps, &self.prim.view(), dt);
         combine(&mut self.st.face_flux, &self.face_old, &[&g_new], &[dt]);
         let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
-        let inp = RhsInput {
-            geo: &self.geo,
-            params: &self.st.params,
-            per,
-            nz,
-            dz: self.grid.dz,
-            eps: &self.st.eps,
-            force: &self.st.force,
-            face_flux: &self.st.face_flux,
-            time: t,
-        };
+        let inp = state_input(&self.st, &self.geo, &self.grid, t);
         let pr = self.prim.view();
         for k in 0..nz - 1 {
             axial_mass_faces(&inp, &self.st.q, &pr, k, &mut self.axial[k * per..(k + 1) * per]);
@@ -730,17 +720,7 @@ impl GasSolver {
 
     /// ṁ_in − ṁ_out of the right-hand side just computed (its primitives and axial faces).
     fn net_inflow(&self, t: f64) -> f64 {
-        let inp = RhsInput {
-            geo: &self.geo,
-            params: &self.st.params,
-            per: self.grid.cells_per_layer(),
-            nz: self.grid.nz,
-            dz: self.grid.dz,
-            eps: &self.st.eps,
-            force: &self.st.force,
-            face_flux: &self.st.face_flux,
-            time: t,
-        };
+        let inp = state_input(&self.st, &self.geo, &self.grid, t);
         net_mass_inflow(&inp, &self.prim.p, &self.axial)
     }
 
@@ -787,17 +767,7 @@ impl GasSolver {
         let per = self.grid.cells_per_layer();
         let nz = self.grid.nz;
         let nf = self.geo.faces.len().max(1);
-        let inp = RhsInput {
-            geo: &self.geo,
-            params: &self.st.params,
-            per,
-            nz,
-            dz: self.grid.dz,
-            eps: &self.st.eps,
-            force: &self.st.force,
-            face_flux: &self.st.face_flux,
-            time: t,
-        };
+        let inp = state_input(&self.st, &self.geo, &self.grid, t);
         let q = &self.st.q;
         let pr = &mut self.prim;
         // Layers per task: all of them on one thread below the parallel size, else one block per thread.
@@ -843,6 +813,21 @@ impl GasSolver {
             .with_min_len(rows)
             .enumerate()
             .for_each(|(k, (o, fh))| residual_layer(&inp, q, pr, axial, k, o, fh));
+    }
+}
+
+/// What the right-hand side reads besides the cells' state, at time t.
+fn state_input<'a>(st: &'a State, geo: &'a FaceGeometry, grid: &CylGrid, t: f64) -> RhsInput<'a> {
+    RhsInput {
+        geo,
+        params: &st.params,
+        per: grid.cells_per_layer(),
+        nz: grid.nz,
+        dz: grid.dz,
+        eps: &st.eps,
+        force: &st.force,
+        face_flux: &st.face_flux,
+        time: t,
     }
 }
 
