@@ -569,14 +569,7 @@ impl GasSolver {
             (self.stage, self.face_stage) = (stage, face_stage);
             self.apply_outlet(dt);
         }
-        self.budget.hist[newest] = net_new;
-        self.st.hist[newest] = f_new;
-        self.st.hist_face[newest] = g_new;
-        self.st.head = newest;
-        self.st.hist_h = [dt, h1];
-        self.st.hist_len = (hl + 1).min(3);
-        self.st.time = t + dt;
-        self.st.steps += 1;
+        self.push_history(newest, (f_new, g_new, net_new), dt);
     }
 
     /// One forward–backward step (forward_backward.rs): the momentum's other terms by AB1 → AB2 →
@@ -628,14 +621,7 @@ impl GasSolver {
         self.apply_outlet(dt);
         let net_new = self.net_inflow(t);
         self.budget.net += dt * net_new;
-        self.budget.hist[newest] = net_new;
-        self.st.hist[newest] = f_new;
-        self.st.hist_face[newest] = g_new;
-        self.st.head = newest;
-        self.st.hist_h = [dt, h1];
-        self.st.hist_len = (hl + 1).min(3);
-        self.st.time = t + dt;
-        self.st.steps += 1;
+        self.push_history(newest, (f_new, g_new, net_new), dt);
     }
 
     /// `step` for AB2/AB3 as one team (team_step.rs); the caller holds the pool's `TeamLock`.
@@ -693,12 +679,18 @@ impl GasSolver {
             1 => ab2[0] * net_new + ab2[1] * bh[i1],
             _ => ab3[0] * net_new + ab3[1] * bh[i1] + ab3[2] * bh[i2],
         };
+        self.push_history(newest, (f_new, g_new, net_new), dt);
+    }
+
+    /// The step's right-hand sides (cells, faces, net inflow) become the newest of the history,
+    /// and the clock moves on by dt.
+    fn push_history(&mut self, newest: usize, (f_new, g_new, net_new): (Vec<[f64; 4]>, Vec<f64>, f64), dt: f64) {
         self.budget.hist[newest] = net_new;
         self.st.hist[newest] = f_new;
         self.st.hist_face[newest] = g_new;
         self.st.head = newest;
-        self.st.hist_h = [dt, h1];
-        self.st.hist_len = (hl + 1).min(3);
+        self.st.hist_h = [dt, self.st.hist_h[0]];
+        self.st.hist_len = (self.st.hist_len + 1).min(3);
         self.st.time += dt;
         self.st.steps += 1;
     }
