@@ -512,13 +512,7 @@ impl GasSolver {
         if forward_backward {
             return self.forward_backward_step(dt);
         }
-        let t = self.st.time;
-        self.q_old.copy_from_slice(&self.st.q);
-        self.face_old.copy_from_slice(&self.st.face_flux);
-        let newest = (self.st.head + 1) % 3;
-        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
-        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
-        self.rhs_into(t, &mut f_new, &mut g_new);
+        let (t, newest, f_new, g_new) = self.start_step();
         let net_new = self.net_inflow(t);
         let hl = self.st.hist_len;
         let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
@@ -576,13 +570,7 @@ impl GasSolver {
     /// AB3 from their own history, the pressure force and the face corrections forward, then the
     /// mass from the new fluxes.
     fn forward_backward_step(&mut self, dt: f64) {
-        let t = self.st.time;
-        self.q_old.copy_from_slice(&self.st.q);
-        self.face_old.copy_from_slice(&self.st.face_flux);
-        let newest = (self.st.head + 1) % 3;
-        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
-        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
-        self.rhs_into(t, &mut f_new, &mut g_new);
+        let (t, newest, mut f_new, g_new) = self.start_step();
         without_pressure_force(&mut f_new, &self.st.eps, &self.prim.view());
         let hl = self.st.hist_len;
         let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
@@ -680,6 +668,19 @@ impl GasSolver {
             _ => ab3[0] * net_new + ab3[1] * bh[i1] + ab3[2] * bh[i2],
         };
         self.push_history(newest, (f_new, g_new, net_new), dt);
+    }
+
+    /// A serial step's start: the old state saved, the right-hand sides of the current state in
+    /// the history's next slots (returned with the time and that slot).
+    fn start_step(&mut self) -> (f64, usize, Vec<[f64; 4]>, Vec<f64>) {
+        let t = self.st.time;
+        self.q_old.copy_from_slice(&self.st.q);
+        self.face_old.copy_from_slice(&self.st.face_flux);
+        let newest = (self.st.head + 1) % 3;
+        let mut f_new = std::mem::take(&mut self.st.hist[newest]);
+        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        self.rhs_into(t, &mut f_new, &mut g_new);
+        (t, newest, f_new, g_new)
     }
 
     /// The step's right-hand sides (cells, faces, net inflow) become the newest of the history,
