@@ -22,6 +22,7 @@
 use crate::coupled::{coupled_round, shipped_case, state_at, Tally};
 use crate::voidage::packing;
 use fluidbed_core::case::{BoxSplit, Case, GasVoidage, Voidage};
+use fluidbed_core::cfd::TimeScheme;
 use fluidbed_core::coupling::build_voidage;
 use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
 use fluidbed_core::grid::CylGrid;
@@ -214,6 +215,43 @@ fn acoustic_point(reference: &Case, r: &Stats, f: f64) {
     );
 }
 
+/// `-- tradeoff scheme`: the gas's time scheme (cfd/forward_backward.rs) at the default interval,
+/// each from the reference's spin-up state, against the reference and beside the noise floor.
+fn scheme_front() {
+    let (reference, floor_case) = (bed(1), bed(2));
+    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
+    let r = stats(&ref_snaps, &fluid_grid(&reference));
+    let (floor_snaps, _) = window(&floor_case, "tradeoff-seed2", 1);
+    let floor = stats(&floor_snaps, &fluid_grid(&floor_case));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
+        "errors": errors(&floor, &r), "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
+    );
+    let interval = reference.coupling.interval_steps;
+    for scheme in [TimeScheme::Ab3, TimeScheme::ForwardBackward] {
+        let state = state_at(&reference, SPIN_UP_S, "tradeoff-seed1");
+        let mut sim = Simulation::restore(&state).expect("state");
+        sim.set_coupling_interval(interval);
+        sim.set_gas_time_scheme(scheme);
+        let window = window_s();
+        sim.set_end_time(SPIN_UP_S + window);
+        let (mut snaps, t0) = (Vec::new(), Instant::now());
+        while !sim.is_finished() {
+            if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
+                snaps.push(s);
+            }
+        }
+        let cost = t0.elapsed().as_secs_f64() / window;
+        let s = stats(&snaps, &fluid_grid(&reference));
+        println!(
+            "{}",
+            json!({"bench": "tradeoff_point", "knob": "gas_time_scheme", "setting": format!("{scheme:?} at interval {interval}"),
+            "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+        );
+    }
+}
+
 /// `-- tradeoff sound`: the reference window and the acoustic speed points alone.
 fn acoustic_front() {
     let reference = bed(1);
@@ -370,6 +408,10 @@ pub fn run() {
     }
     if part == "sound" {
         acoustic_front();
+    }
+    if part == "scheme" {
+        scheme_front();
+        return;
     }
     if part.is_empty() || part == "cost" {
         interleaved_costs();
