@@ -393,8 +393,8 @@ pub struct Gas {
     #[serde(default = "d_acoustic_speed_factor")]
     pub acoustic_speed_factor: f64,
     /// Time scheme of the gas: "ab3" (the paper's, PHYSICS.md 7) or "forward_backward" (the
-    /// acoustic terms forward–backward, the rest AB3: a stable step 2.76× longer;
-    /// docs/VALIDATION.md "Forward–backward gas step").
+    /// acoustic terms forward–backward, the rest AB3: a stable step 2.07× longer, but it leaves
+    /// an acoustic mode in the pressure drop; docs/VALIDATION.md "Forward–backward gas step").
     #[serde(default, skip_serializing_if = "crate::cfd::TimeScheme::is_ab3")]
     pub time_scheme: crate::cfd::TimeScheme,
 }

@@ -11,17 +11,19 @@
 //! neutral (|amplification| = 1, no damping) for ωΔt ≤ 2, against AB3's 0.7236 on the imaginary
 //! axis, with a phase error O((ωΔt)²) on waves that the gas's physics does not need resolved
 //! in time (the bed's pressure oscillations are ~10 Hz, the cell's acoustic modes ~10⁵ Hz).
-//! The stable step (stability.rs) is therefore 2/0.7236 = 2.76× AB3's for the acoustic part;
-//! the convective and viscous parts keep AB3's bounds.
+//! The gas's dissipations and outlet lower the real edge, so the stable step (stability.rs) uses
+//! ωΔt ≤ 1.5 (2.07× AB3's at the same CFL factor; measured edges in docs/VALIDATION.md); the
+//! convective and viscous parts keep AB3's bounds. Being neutral, it does not damp the column's
+//! acoustic modes as AB3 does (a 189-Hz mode dominates a bubbling bed's ΔP: not a default).
 //!
 //! The mass passes below repeat rhs.rs's face mass flux term by term (the same expressions in
-//! the same order, so at the old state they give the AB3 right-hand side's mass row bit for bit:
-//! test `the_mass_pass_at_the_old_state_is_the_right_hand_sides_mass_row`).
+//! the same order); the tests of cfd/tests/forward_backward.rs check them through the steady
+//! bed's analytic drop and the mass budget.
 
 use super::params::Outlet;
 use super::rhs::{inlet_mass_flux, PrimView, RhsInput, PRESSURE_DISSIPATION};
 
-/// The forward–backward scheme's bound on ωΔt for the acoustic terms (see the module comment).
+/// The bound on ωΔt for the acoustic terms (2 for the pure scheme; see the module comment).
 pub const FB_ACOUSTIC_LIMIT: f64 = 1.5;
 
 /// ṁ (kg/s) of the axial faces above the cells of layer k (k + 1 < nz) from the momentum of `q`

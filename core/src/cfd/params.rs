@@ -35,7 +35,7 @@ pub enum TimeScheme {
     #[default]
     Ab3,
     /// Forward–backward for the acoustic terms (the pressure force forward, the mass fluxes of the
-    /// new momentum backward), AB3 for the rest: a stable step 2/0.7236 = 2.76× AB3's.
+    /// new momentum backward), AB3 for the rest: a stable step 2.07× AB3's (stability.rs).
     ForwardBackward,
 }
 
