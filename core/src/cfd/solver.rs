@@ -196,6 +196,9 @@ impl GasSolver {
     }
     /// Run parallel right-hand sides as one team of threads when the pool is free for one (default
     /// on); off, as four parallel loops (the same bits; for benchmarks).
+    pub fn set_team(&mut self, on: bool) {
+        self.team = on;
+    }
     /// Recount the steps taken (`Simulation::set_gas_time_scheme`: the count of the new step's length).
     pub fn set_steps(&mut self, steps: u64) {
         self.st.steps = steps;
@@ -206,9 +209,6 @@ impl GasSolver {
     }
     pub fn time_scheme(&self) -> TimeScheme {
         self.scheme
-    }
-    pub fn set_team(&mut self, on: bool) {
-        self.team = on;
     }
     pub fn time(&self) -> f64 {
         self.st.time
@@ -572,25 +572,11 @@ impl GasSolver {
     fn forward_backward_step(&mut self, dt: f64) {
         let (t, newest, mut f_new, g_new) = self.start_step();
         without_pressure_force(&mut f_new, &self.st.eps, &self.prim.view());
-        let hl = self.st.hist_len;
-        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        let (w, m) = self.multistep_weights(dt);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
-        {
-            let (q, q0) = (self.st.q.as_flattened_mut(), self.q_old.as_flattened());
-            let h = &self.st.hist;
-            match hl {
-                0 => combine(q, q0, &[f_new.as_flattened()], &[dt]),
-                1 => {
-                    combine(q, q0, &[f_new.as_flattened(), h[i1].as_flattened()], &ab2_weights(dt, h1).map(|w| w * dt))
-                }
-                _ => combine(
-                    q,
-                    q0,
-                    &[f_new.as_flattened(), h[i1].as_flattened(), h[i2].as_flattened()],
-                    &ab3_weights(dt, h1, h2).map(|w| w * dt),
-                ),
-            }
-        }
+        let h = &self.st.hist;
+        let fs = [f_new.as_flattened(), h[i1].as_flattened(), h[i2].as_flattened()];
+        combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &fs[..=m], &w[..=m]);
         add_pressure_force(&mut self.st.q, &self.st.eps, &self.prim.view(), dt);
         combine(&mut self.st.face_flux, &self.face_old, &[&g_new], &[dt]);
         let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
@@ -617,21 +603,13 @@ impl GasSolver {
         let newest = (self.st.head + 1) % 3;
         let mut f_new = std::mem::take(&mut self.st.hist[newest]);
         let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
-        let hl = self.st.hist_len;
-        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
-        let ab1 = [dt];
-        let ab2 = ab2_weights(dt, h1).map(|w| w * dt);
-        let ab3 = ab3_weights(dt, h1, h2).map(|w| w * dt);
+        let (w, m) = self.multistep_weights(dt);
+        let weights = &w[..=m];
         let (h, hf) = (&self.st.hist, &self.st.hist_face);
         let two = [&h[i1][..], &h[i2][..]];
         let two_face = [&hf[i1][..], &hf[i2][..]];
         let forward_backward = self.scheme == TimeScheme::ForwardBackward;
-        let (weights, m): (&[f64], usize) = match hl {
-            0 => (&ab1, 0),
-            1 => (&ab2, 1),
-            _ => (&ab3, 2),
-        };
         let (past, past_face) = (&two[..m], &two_face[..m]);
         let inp = StepInput {
             geo: &self.geo,
@@ -662,12 +640,26 @@ impl GasSolver {
         // The team's primitives and axial faces are those of this step's right-hand side.
         let net_new = self.net_inflow(self.st.time);
         let bh = self.budget.hist;
-        self.budget.net += match hl {
+        self.budget.net += match m {
             _ if forward_backward => dt * net_new,
-            1 => ab2[0] * net_new + ab2[1] * bh[i1],
-            _ => ab3[0] * net_new + ab3[1] * bh[i1] + ab3[2] * bh[i2],
+            1 => w[0] * net_new + w[1] * bh[i1],
+            _ => w[0] * net_new + w[1] * bh[i1] + w[2] * bh[i2],
         };
         self.push_history(newest, (f_new, g_new, net_new), dt);
+    }
+
+    /// The multistep weights times the step for the history there is (AB1, AB2 or AB3: the newest
+    /// right-hand side's, then the past ones'), padded to three, and how many past ones they use.
+    fn multistep_weights(&self, dt: f64) -> ([f64; 3], usize) {
+        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        match self.st.hist_len {
+            0 => ([dt, 0.0, 0.0], 0),
+            1 => {
+                let [a, b] = ab2_weights(dt, h1).map(|w| w * dt);
+                ([a, b, 0.0], 1)
+            }
+            _ => (ab3_weights(dt, h1, h2).map(|w| w * dt), 2),
+        }
     }
 
     /// A serial step's start: the old state saved, the right-hand sides of the current state in
