@@ -5,6 +5,7 @@ mod adaptive;
 mod cfd;
 mod coupled;
 mod dem;
+mod dp_probe;
 mod halo;
 mod plan;
 mod restitution;
@@ -35,6 +36,7 @@ fn run(what: &str) {
         "scaling" => scaling::run(),
         "restitution" => restitution::run(),
         "dem" => dem::run(),
+        "dp-probe" => dp_probe::run(),
         "halo" => halo::run(),
         "plan" => plan::run(),
         "voidage" => voidage::run(),

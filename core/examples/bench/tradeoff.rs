@@ -31,7 +31,7 @@ use serde_json::json;
 use std::f64::consts::PI;
 use std::time::Instant;
 
-const SPIN_UP_S: f64 = 0.2;
+pub(crate) const SPIN_UP_S: f64 = 0.2;
 const WINDOW_S: f64 = 0.3;
 
 /// The window of each point: `WINDOW_S`, or `FLUIDBED_TRADEOFF_WINDOW_S` seconds.
@@ -40,7 +40,7 @@ fn window_s() -> f64 {
 }
 
 /// The trade-off bed: the quickstart's 22-mm column with the paper's particles and DEM step.
-fn bed(seed: u64) -> Case {
+pub(crate) fn bed(seed: u64) -> Case {
     let mut c = shipped_case("quickstart.json");
     c.particles.youngs_modulus_pa = 1.2e8;
     c.dem.time_step_s = 1.25e-6;

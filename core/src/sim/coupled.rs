@@ -1,7 +1,8 @@
 //! The coupled step (paper section 2.3): voidage from the particles, drag and −V∇p on the
 //! particles, the opposite drag on the gas in the cell of each particle's centre, recomputed every
 //! `coupling.interval_steps` DEM steps and held in between; the gas steps at its own stable step
-//! and the particles at the DEM step, both by AB3. With drag-voidage sub-layers
+//! (a whole fraction of the coupling interval when that is longer, plan.rs `aligned_gas_dt`) and
+//! the particles at the DEM step, both by AB3. With drag-voidage sub-layers
 //! (`coupling.drag_voidage_sublayers` = n > 1) the voidage method runs on the grid of n sub-layers
 //! per fluid layer; the cells' solid volume is the sum of their sub-cells' (exact: solid volume
 //! adds), and the drag reads the sub-cells' voidage averaged over a window of three sub-layers
@@ -193,7 +194,7 @@ impl Simulation {
         let (true, Some(dt_g)) = (plan.gas, plan.gas_dt_s) else { return Ok(()) };
         let dt = self.st.case.dem.time_step_s;
         // Gas steps that reach the end of the DEM steps taken (to within rounding).
-        let target = (self.st.steps as f64 * dt / dt_g - 1e-9).ceil().max(0.0) as u64;
+        let target = super::plan::gas_steps_due(self.st.steps, dt, dt_g);
         let gas = self.st.gas.as_mut().expect("gas");
         let mean = plan.particles_move && self.st.case.coupling.pressure_force == PressureForce::IntervalMean;
         let t0 = std::time::Instant::now();

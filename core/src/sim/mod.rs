@@ -196,7 +196,7 @@ impl Simulation {
             // `sync_gas` counts gas steps of the plan's length: recount the steps taken in it.
             if let Some(dt_g) = self.st.plan.gas_dt_s {
                 let dt = self.st.case.dem.time_step_s;
-                gas.set_steps((self.st.steps as f64 * dt / dt_g - 1e-9).ceil().max(0.0) as u64);
+                gas.set_steps(plan::gas_steps_due(self.st.steps, dt, dt_g));
             }
         }
     }

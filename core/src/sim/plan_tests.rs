@@ -2,6 +2,7 @@
 //! speed-up of each is measured by `bench -- plan`): to round-off where the skip is exact, within
 //! a stated tolerance where the working scene is a different computation of the same physics.
 
+use super::plan::{aligned_gas_dt, gas_steps_due};
 use super::tests::lattice_case;
 use super::*;
 use crate::case::Gas;
@@ -152,4 +153,39 @@ fn a_bed_without_gas_settles_as_under_still_gas() {
     // the contact overlaps (already ≪ d) by that fraction.
     let d = dry.case().particles.diameter_m;
     assert!((mean_z(&dry) - mean_z(&wet)).abs() < 1e-4 * d, "{} vs {}", mean_z(&dry), mean_z(&wet));
+}
+
+#[test]
+fn the_gas_steps_a_whole_fraction_of_the_coupling_interval_and_meets_the_particles_at_each_coupling() {
+    assert_eq!(aligned_gas_dt(3.33e-6, 1.25e-6), 3.33e-6, "an interval shorter than the cap keeps the cap");
+    assert!((aligned_gas_dt(3.33e-6, 12.5e-6) - 3.125e-6).abs() < 1e-20);
+    assert!((aligned_gas_dt(6.89e-6, 25e-6) - 6.25e-6).abs() < 1e-20);
+    assert_eq!(gas_steps_due(3, 1.0, 1.5), 2);
+    assert_eq!(gas_steps_due(10_000_000, 1.25e-6, 6.25e-6), 2_000_000, "a whole count up to rounding");
+
+    let mut c = super::resume_tests::case();
+    c.coupling.interval_steps = 6;
+    let mut sim = Simulation::new(c, None).unwrap();
+    let (dt, dt_g) = (sim.case().dem.time_step_s, sim.plan().gas_dt_s.unwrap());
+    let per_interval = 6.0 * dt / dt_g;
+    assert!(
+        per_interval >= 1.0 && (per_interval - per_interval.round()).abs() < 1e-9,
+        "{per_interval} gas steps per interval"
+    );
+    let stable = sim.gas().unwrap().stable_dt();
+    assert!(dt_g <= stable && dt_g > 0.5 * stable, "gas step {dt_g:e} s, stable {stable:e} s");
+    let mut couplings = 0;
+    while sim.steps() < 60 {
+        let coupling_at = sim.steps();
+        sim.step().unwrap();
+        if coupling_at.is_multiple_of(6) && coupling_at > 0 {
+            let (t_gas, t_dem) = (sim.gas().unwrap().time(), coupling_at as f64 * dt);
+            assert!(
+                (t_gas - t_dem).abs() < 1e-12 * t_dem,
+                "step {coupling_at}: gas at {t_gas:e} s, particles at {t_dem:e} s"
+            );
+            couplings += 1;
+        }
+    }
+    assert_eq!(couplings, 9);
 }

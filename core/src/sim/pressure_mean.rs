@@ -68,7 +68,7 @@ mod tests {
         // gradient of the state each starts from, as the gas solver reports it.
         let mut gas = a.gas().unwrap().clone();
         let (dt, dt_g) = (a.st.case.dem.time_step_s, a.plan().gas_dt_s.unwrap());
-        let target = (606.0 * dt / dt_g - 1e-9).ceil() as u64;
+        let target = crate::sim::plan::gas_steps_due(606, dt, dt_g);
         let cells = a.grid.num_cells();
         let mut sum = vec![[0.0f64; 3]; cells];
         let mut steps = 0;
