@@ -4,9 +4,10 @@
 //! DEM steps (5 µs; Nyquist 100 kHz). Printed per scheme: the gas step, ΔP's mean and standard
 //! deviation, the r.m.s. above 5 kHz (no bed motion is that fast: gas-step noise), the dominant
 //! frequency of the full record and of it read every 2 ms (the snapshot rate of `-- tradeoff`,
-//! where faster oscillations alias to low frequencies).
+//! where faster oscillations alias to low frequencies). `-- dp-probe 44`: the shipped 44-mm
+//! bubbling bed from the coupled bench's 0.3-s state instead.
 
-use crate::coupled::state_at;
+use crate::coupled::{shipped_case, state_at, FLUIDIZED_AT_S};
 use crate::tradeoff::{bed, SPIN_UP_S};
 use fluidbed_core::analysis::spectrum::{dominant_frequency, welch};
 use fluidbed_core::cfd::TimeScheme;
@@ -17,11 +18,18 @@ const WINDOW_S: f64 = 0.2;
 const EVERY: u64 = 4;
 
 pub fn run() {
-    let reference = bed(1);
+    let shipped = std::env::args().nth(2).as_deref() == Some("44");
+    let (reference, start) =
+        if shipped { (shipped_case("bubbling-44mm.json"), FLUIDIZED_AT_S) } else { (bed(1), SPIN_UP_S) };
+    let state = if shipped {
+        state_at(&reference, start, "bubbling-44mm")
+    } else {
+        state_at(&reference, start, "tradeoff-seed1")
+    };
     for scheme in [TimeScheme::Ab3, TimeScheme::ForwardBackward] {
-        let mut sim = Simulation::restore(&state_at(&reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
+        let mut sim = Simulation::restore(&state).expect("state");
         sim.set_gas_time_scheme(scheme);
-        sim.set_end_time(SPIN_UP_S + WINDOW_S);
+        sim.set_end_time(start + WINDOW_S);
         let dt = EVERY as f64 * reference.dem.time_step_s;
         let mut dp = Vec::new();
         while !sim.is_finished() {

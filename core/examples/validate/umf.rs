@@ -34,8 +34,8 @@ struct Sweep {
     sublayers: Option<u32>,
     /// `coupling.pressure_force` (None: the case's).
     pressure_force: Option<PressureForce>,
-    /// `gas.time_scheme` "forward_backward" (else the case's).
-    forward_backward: bool,
+    /// `gas.time_scheme` "ab3", the paper's (else the case's).
+    ab3: bool,
 }
 
 impl Sweep {
@@ -52,7 +52,7 @@ impl Sweep {
             dz_over_dr: 0.5,
             sublayers: None,
             pressure_force: None,
-            forward_backward: false,
+            ab3: false,
         }
     }
 
@@ -74,8 +74,8 @@ impl Sweep {
                 "sublayers" => s.sublayers = Some(x as u32),
                 "pressure_gas_step" => s.pressure_force = (x != 0.0).then_some(PressureForce::GasStep),
                 "pressure_mean" => s.pressure_force = (x != 0.0).then_some(PressureForce::IntervalMean),
-                "forward_backward" => s.forward_backward = x != 0.0,
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, forward_backward)"),
+                "ab3" => s.ab3 = x != 0.0,
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, ab3)"),
             }
         }
         s
@@ -111,8 +111,8 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;
     }
-    if sw.forward_backward {
-        case.gas.as_mut().expect("gas").time_scheme = fluidbed_core::cfd::TimeScheme::ForwardBackward;
+    if sw.ab3 {
+        case.gas.as_mut().expect("gas").time_scheme = fluidbed_core::cfd::TimeScheme::Ab3;
     }
     let dz = sw.dz_over_dr * case.grid.dr_m;
     case.grid.dz_m = Some(dz);

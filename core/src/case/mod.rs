@@ -392,10 +392,10 @@ pub struct Gas {
     /// grows as 1/f and the density stays within Δp/(f a)² of ρ_out.
     #[serde(default = "d_acoustic_speed_factor")]
     pub acoustic_speed_factor: f64,
-    /// Time scheme of the gas: "ab3" (the paper's, PHYSICS.md 7) or "forward_backward" (the
-    /// acoustic terms forward–backward, the rest AB3: a stable step 2.07× longer, but it leaves
-    /// an acoustic mode in the pressure drop; docs/VALIDATION.md "Forward–backward gas step").
-    #[serde(default, skip_serializing_if = "crate::cfd::TimeScheme::is_ab3")]
+    /// Time scheme of the gas: "forward_backward" (the default: the acoustic terms
+    /// forward–backward, the rest AB3, a stable step 2.07× AB3's) or "ab3" (the paper's, PHYSICS.md
+    /// 7, on the whole right-hand side); docs/VALIDATION.md "Forward–backward gas step".
+    #[serde(default, skip_serializing_if = "crate::cfd::TimeScheme::is_default")]
     pub time_scheme: crate::cfd::TimeScheme,
 }
 

@@ -162,7 +162,8 @@ impl GasSolver {
             budget: MassBudget::default(),
             ramp: None,
             face_inputs: Vec::new(),
-            scheme: TimeScheme::Ab3,
+            // The checkpoint holds no scheme: the default until set (`Simulation::restore` sets the case's).
+            scheme: TimeScheme::default(),
             mass_rate: vec![0.0; n],
             grid,
         }

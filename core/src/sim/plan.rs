@@ -39,7 +39,7 @@ impl Plan {
             (true, Some(stable)) => {
                 let user = case.gas.as_ref().and_then(|g| g.time_step_s);
                 let cap = user.unwrap_or(stable).min(stable);
-                let held = particles_move && n_particles > 0 && case.coupling.interval_steps > 1;
+                let held = n_particles > 0 && case.coupling.interval_steps > 1;
                 Some(if held { aligned_gas_dt(cap, case.coupling.interval_steps as f64 * dt) } else { cap })
             }
             _ => None,

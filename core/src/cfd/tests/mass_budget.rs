@@ -10,8 +10,14 @@ use crate::team::solver_pool;
 /// A 10-layer column with a bed-like voidage in its lower half, a drag-like force, a swirling,
 /// rising flow and the inflow ramping up.
 pub(super) fn fed_bed(outlet: Outlet) -> GasSolver {
-    let gas =
-        Gas { superficial_velocity_m_s: 0.6, ramp_time_s: 0.002, bulk_viscosity_pa_s: 1e-4, ..Default::default() };
+    // AB3: the forward–backward step's budget has its own test (forward_backward.rs).
+    let gas = Gas {
+        superficial_velocity_m_s: 0.6,
+        ramp_time_s: 0.002,
+        bulk_viscosity_pa_s: 1e-4,
+        time_scheme: crate::cfd::TimeScheme::Ab3,
+        ..Default::default()
+    };
     let mut s = solver(gas, 9.81, 3, 0.004, 10, 0.004);
     s.set_outlet(outlet);
     s.set_initial_voidage(&bed_voidage(&s, 0));
@@ -79,12 +85,15 @@ fn the_budget_continues_across_a_checkpoint_and_a_wrong_one_shows() {
     let mut a = fed_bed(Outlet::Characteristic);
     run(&mut a, 300, 0);
     let bytes = bincode::serialize(&a).unwrap();
+    // The checkpoint holds no scheme (the simulation's restore sets the case's).
     let mut b: GasSolver = bincode::deserialize(&bytes).unwrap();
+    b.set_time_scheme(a.time_scheme());
     b.set_mass_budget(a.mass_budget());
     let worst = run(&mut b, 300, 300);
     assert!(worst < 1e-13, "after the resume: budget error {worst:.3e}");
     // Without the budget's section the resumed run starts a budget of its own, which closes too.
     let mut c: GasSolver = bincode::deserialize(&bytes).unwrap();
+    c.set_time_scheme(a.time_scheme());
     let worst = run(&mut c, 300, 300);
     assert!(worst < 1e-13, "budget started at the resume: error {worst:.3e}");
     assert!(c.mass_balance().change.abs() < b.mass_balance().change.abs() + b.mass_balance().held);

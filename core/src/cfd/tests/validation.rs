@@ -2,12 +2,12 @@
 
 use super::support::case_with;
 use crate::case::Gas;
-use crate::cfd::{case_stable_time_step, GasSolver, AB3_IMAGINARY_LIMIT, FACE_FLUX_RATE};
+use crate::cfd::{case_stable_time_step, GasSolver, TimeScheme, AB3_IMAGINARY_LIMIT, FACE_FLUX_RATE};
 use crate::grid::CylGrid;
 
 #[test]
 fn too_large_a_gas_step_is_refused_with_the_limit() {
-    let mut case = case_with(Gas::default(), 9.81, 0.022, 0.12);
+    let mut case = case_with(Gas { time_scheme: TimeScheme::Ab3, ..Gas::default() }, 9.81, 0.022, 0.12);
     case.grid.dz_m = Some(0.0044444444444444444);
     let limit = case_stable_time_step(&case).unwrap();
     // Acoustic bound: AB3's 0.7236 over a'·√(H² + 1/dz²), H = (1 + n0/π)/dr, a' = a/√(1 − s₀) with
@@ -31,7 +31,7 @@ fn too_large_a_gas_step_is_refused_with_the_limit() {
 #[test]
 fn solver_stable_step_at_rest_is_at_least_the_case_limit() {
     // The case limit assumes the inlet speed everywhere; gas at rest allows a slightly longer step.
-    let case = case_with(Gas::default(), 9.81, 0.022, 0.12);
+    let case = case_with(Gas { time_scheme: TimeScheme::Ab3, ..Gas::default() }, 9.81, 0.022, 0.12);
     let s = GasSolver::new(&case, CylGrid::new(0.022, 0.12, 0.0044, case.grid_dz_m(), 3));
     let limit = case_stable_time_step(&case).unwrap();
     assert!(s.stable_dt() >= limit && s.stable_dt() < 1.01 * limit, "{} vs {limit}", s.stable_dt());
