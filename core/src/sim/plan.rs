@@ -101,7 +101,7 @@ impl Plan {
             out.push("gas solver: the case has no gas section".into());
         } else if let Some(g) = self.gas_dt_s.filter(|_| self.gas_steps_per_dem_step < 1.0) {
             out.push(format!(
-                "gas steps: sub-cycled at its stable step {:.3} µs, {:.2} gas steps per DEM step",
+                "gas steps: sub-cycled at {:.3} µs (stable, in whole fractions of a longer coupling interval), {:.2} gas steps per DEM step",
                 g * 1e6,
                 self.gas_steps_per_dem_step
             ));
