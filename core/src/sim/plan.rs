@@ -62,7 +62,7 @@ impl Plan {
 /// above `cap` that divides the interval into whole steps, when the interval is at least `cap`.
 /// Each interval's held voidage and force then act on the gas for exactly the interval: with
 /// steps that straddle the couplings the share of the interval each gas step sees beats against
-/// the coupling rate, which drove a 13-kHz ΔP oscillation of ±7 Pa on the 22-mm bed
+/// the coupling rate, which drove a 15-kHz ΔP oscillation of 10 Pa r.m.s. on the 22-mm bed
 /// (docs/VALIDATION.md, "Gas steps in whole fractions of the coupling interval").
 pub fn aligned_gas_dt(cap: f64, interval_s: f64) -> f64 {
     if interval_s < cap {
