@@ -516,36 +516,18 @@ impl GasSolver {
         let (t, newest, f_new, g_new) = self.start_step();
         let net_new = self.net_inflow(t);
         let hl = self.st.hist_len;
-        let (h1, h2) = (self.st.hist_h[0], self.st.hist_h[1]);
+        // Heun's predictor (no history: w = [dt]), else AB2 or AB3.
+        let (w, m) = self.multistep_weights(dt);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
-        let bh = self.budget.hist;
         {
-            let (q, q0) = (self.st.q.as_flattened_mut(), self.q_old.as_flattened());
-            let (ff, ff0) = (&mut self.st.face_flux, &self.face_old);
-            match hl {
-                0 => {
-                    // Heun predictor.
-                    combine(q, q0, &[f_new.as_flattened()], &[dt]);
-                    combine(ff, ff0, &[&g_new], &[dt]);
-                }
-                1 => {
-                    let b = ab2_weights(dt, h1).map(|w| w * dt);
-                    combine(q, q0, &[f_new.as_flattened(), self.st.hist[i1].as_flattened()], &b);
-                    combine(ff, ff0, &[&g_new, &self.st.hist_face[i1]], &b);
-                    self.budget.net += b[0] * net_new + b[1] * bh[i1];
-                }
-                _ => {
-                    let b = ab3_weights(dt, h1, h2).map(|w| w * dt);
-                    combine(
-                        q,
-                        q0,
-                        &[f_new.as_flattened(), self.st.hist[i1].as_flattened(), self.st.hist[i2].as_flattened()],
-                        &b,
-                    );
-                    combine(ff, ff0, &[&g_new, &self.st.hist_face[i1], &self.st.hist_face[i2]], &b);
-                    self.budget.net += b[0] * net_new + b[1] * bh[i1] + b[2] * bh[i2];
-                }
-            }
+            let (h, hf) = (&self.st.hist, &self.st.hist_face);
+            let fs = [f_new.as_flattened(), h[i1].as_flattened(), h[i2].as_flattened()];
+            let gs = [&g_new[..], &hf[i1][..], &hf[i2][..]];
+            combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &fs[..=m], &w[..=m]);
+            combine(&mut self.st.face_flux, &self.face_old, &gs[..=m], &w[..=m]);
+        }
+        if hl > 0 {
+            self.budget.net += self.multistep_inflow(&w[..=m], net_new);
         }
         self.apply_outlet(dt);
         if hl == 0 {
@@ -640,12 +622,8 @@ impl GasSolver {
         team_step(&inp, s);
         // The team's primitives and axial faces are those of this step's right-hand side.
         let net_new = self.net_inflow(self.st.time);
-        let bh = self.budget.hist;
-        self.budget.net += match m {
-            _ if forward_backward => dt * net_new,
-            1 => w[0] * net_new + w[1] * bh[i1],
-            _ => w[0] * net_new + w[1] * bh[i1] + w[2] * bh[i2],
-        };
+        // The forward–backward step moves the mass forward (its inflow over dt), AB the rest.
+        self.budget.net += if forward_backward { dt * net_new } else { self.multistep_inflow(weights, net_new) };
         self.push_history(newest, (f_new, g_new, net_new), dt);
     }
 
@@ -661,6 +639,14 @@ impl GasSolver {
             }
             _ => (ab3_weights(dt, h1, h2).map(|w| w * dt), 2),
         }
+    }
+
+    /// The net mass inflow over a multistep step: the weights `w` (times the step, the newest
+    /// first) over the newest inflow and the history's, as the cells' state is stepped.
+    fn multistep_inflow(&self, w: &[f64], net_new: f64) -> f64 {
+        let bh = self.budget.hist;
+        let past = [bh[self.st.head], bh[(self.st.head + 2) % 3]];
+        w[1..].iter().zip(past).fold(w[0] * net_new, |s, (w, b)| s + w * b)
     }
 
     /// A serial step's start: the old state saved, the right-hand sides of the current state in
