@@ -186,12 +186,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                 // The AB update of the own rows: y = y_old + Σ w_i f_i.
                 let w = inp.weights;
                 unsafe {
-                    let (y, y0, f) = (q.part(c0, c1), q_old.view(c0, c1), rhs.view(c0, c1));
-                    let mut fs: [&[f64]; 3] = [f.as_flattened(), &[], &[]];
-                    for (i, h) in inp.past.iter().enumerate() {
-                        fs[i + 1] = h[c0..c1].as_flattened();
-                    }
-                    combine(y.as_flattened_mut(), y0.as_flattened(), &fs[..w.len()], w);
+                    multistep_cells(inp, [q, q_old, rhs], c0, c1);
                     for (lo, hi) in [(c0, c1), (f0, f1)] {
                         let (y, y0, f) = (face.part(lo, hi), face_old.view(lo, hi), rhs_face.view(lo, hi));
                         let mut fs: [&[f64]; 3] = [f, &[], &[]];
@@ -237,6 +232,20 @@ unsafe fn full_view<'a>(f: [Raw<f64>; 10], n: usize) -> PrimView<'a> {
     PrimView { ux, uy, uz, p, beta, beta_over_eps2, div, gx, gy, gz }
 }
 
+/// The multistep update of the cells c0..c1: q = q_old + Σ w_i f_i over the new right-hand side
+/// `rhs` and `inp.past` (`[q, q_old, rhs]`).
+///
+/// # Safety
+/// The rows c0..c1 of q are the calling thread's own, and no thread writes q_old or rhs there.
+unsafe fn multistep_cells(inp: &StepInput, [q, q_old, rhs]: [Raw<[f64; 4]>; 3], c0: usize, c1: usize) {
+    let w = inp.weights;
+    let mut fs: [&[f64]; 3] = [rhs.view(c0, c1).as_flattened(), &[], &[]];
+    for (i, h) in inp.past.iter().enumerate() {
+        fs[i + 1] = h[c0..c1].as_flattened();
+    }
+    combine(q.part(c0, c1).as_flattened_mut(), q_old.view(c0, c1).as_flattened(), &fs[..w.len()], w);
+}
+
 /// A thread's block: its layers k0..k1 and its horizontal-face rows f0..f1.
 struct Rows {
     k: (usize, usize),
@@ -274,14 +283,8 @@ unsafe fn forward_backward_rows(inp: &StepInput, a: &FbArrays, barrier: &SpinBar
         let (f, e) = (a.rhs.part(c0, c1), &inp.eps[c0..c1]);
         let own = PrimView { gx: &pr.gx[c0..c1], gy: &pr.gy[c0..c1], gz: &pr.gz[c0..c1], ..pr };
         without_pressure_force(f, e, &own);
-        let w = inp.weights;
-        let (y, y0) = (a.q.part(c0, c1), a.q_old.view(c0, c1));
-        let mut fs: [&[f64]; 3] = [a.rhs.view(c0, c1).as_flattened(), &[], &[]];
-        for (i, h) in inp.past.iter().enumerate() {
-            fs[i + 1] = h[c0..c1].as_flattened();
-        }
-        combine(y.as_flattened_mut(), y0.as_flattened(), &fs[..w.len()], w);
-        add_pressure_force(y, e, &own, inp.dt);
+        multistep_cells(inp, [a.q, a.q_old, a.rhs], c0, c1);
+        add_pressure_force(a.q.part(c0, c1), e, &own, inp.dt);
         for (lo, hi) in [(c0, c1), (f0, f1)] {
             let (y, y0, f) = (a.face.part(lo, hi), a.face_old.view(lo, hi), a.rhs_face.view(lo, hi));
             combine(y, y0, &[f], &[inp.dt]);
