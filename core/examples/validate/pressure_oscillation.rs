@@ -53,7 +53,7 @@ pub fn run() -> Value {
     println!("{bubbling}");
     let mut slugging = Vec::new();
     for u in [0.54, 0.60] {
-        match crate::slug_rise::finished_at(u) {
+        match crate::slug_rise::finished_at(u, crate::slug_rise::BUBBLING_TUBE) {
             Some(done) => {
                 let p = point(
                     &format!("44-mm bed, 160 mm settled, U = {u} m/s"),

@@ -1,9 +1,11 @@
-//! Slug rise velocity (issue: science, paper section 3.4 and Fig. 8): a tall bed of the paper's
-//! particles — the bubbling case's 44-mm column and grid (dr 4.4 mm, layers dr/2, its voidage),
-//! 160 mm settled as the paper's slugging bed (≈ 165k particles), 0.321 m tall — at four velocities
-//! between 1.2 and 2 U_mf. (The 22-mm column, D/d = 18, made flat wall-spanning plugs, for which
-//! the formula is not meant, and a 90-mm bed in the 44-mm column had only growing bubbles at its
-//! probes: docs/VALIDATION.md; 44 mm is D/d = 37, near the paper's 50-mm tube.) Each run's
+//! Slug rise velocity (issue: science, paper section 3.4 and Fig. 8): the paper's slugging bed —
+//! its particles, 160 mm settled in its 50-mm tube (≈ 210k particles) on the bubbling case's cells
+//! (dr = D/10, layers dr/2) and voidage, 0.32 m tall — at four velocities between 1.2 and 2 U_mf.
+//! `FLUIDBED_SLUG_COLUMN_MM=44` runs (or reads) the same bed in the bubbling case's own 44-mm
+//! column (≈ 165k particles, 0.321 m), where the runs at 0.54 and 0.60 m/s made flat plugs over
+//! wall slugs (docs/VALIDATION.md), which is why the check moved to the paper's tube. (The 22-
+//! and 30-mm columns plugged too, and a 90-mm bed in the 44-mm column had only growing bubbles
+//! at its probes.) Each run's
 //! analysis (accumulated while it runs, from `FROM_S` to `END_S`) gives the rise velocity by
 //! cross-correlating the cross-section voidage at 120 and 160 mm above the distributor (the paper:
 //! slugs fully formed from ≈ 120 mm, measured at 140 mm; Müller et al. 2007a's method), against
@@ -15,8 +17,8 @@
 //! Each velocity is a long run (≈ 2.6 simulated s): it keeps a checkpoint in target/validate-cache
 //! every 0.05 s and resumes there; a finished run keeps its last checkpoint there and is not run
 //! again (its analysis is read from that checkpoint by the current build). Voidage slices
-//! of the last snapshots go to docs/img/slug_rise_44mm_160mm_U*.png, to tell round-nosed slugs from
-//! wall-spanning plugs.
+//! of the last snapshots go to docs/img/slug_rise_<D>mm_160mm_U*.png, to tell round-nosed slugs
+//! from wall-spanning plugs.
 
 use crate::common::*;
 use fluidbed_core::case::{Bed, Case, Field};
@@ -34,7 +36,6 @@ const UMF: f64 = 0.30;
 const FROM_S: f64 = 0.8;
 const END_S: f64 = 2.8;
 const SETTLED_M: f64 = 0.16;
-const COLUMN_M: f64 = 0.3212; // 146 layers of 2.2 mm
 /// The two cross-sections of the rise velocity (m above the distributor), about the paper's 140 mm.
 const PROBES_M: [f64; 2] = [0.12, 0.16];
 
@@ -52,11 +53,37 @@ pub struct Finished {
     pub analysis: AnalysisReport,
 }
 
-/// The slugging bed at superficial velocity `u`.
-fn case(u: f64) -> Case {
+/// The tube: its diameter in mm, its height (whole layers) and cell width.
+#[derive(Clone, Copy)]
+pub struct Tube {
+    pub mm: u32,
+    height_m: f64,
+    dr_m: f64,
+}
+
+/// The paper's 50-mm tube (128 layers of 2.5 mm) and the bubbling case's 44-mm one (146 of 2.2 mm).
+pub const PAPER_TUBE: Tube = Tube { mm: 50, height_m: 0.32, dr_m: 0.005 };
+pub const BUBBLING_TUBE: Tube = Tube { mm: 44, height_m: 0.3212, dr_m: 0.0044 };
+
+/// The tube of this run: the paper's, or the 44-mm one with `FLUIDBED_SLUG_COLUMN_MM=44`.
+fn tube() -> Tube {
+    match std::env::var("FLUIDBED_SLUG_COLUMN_MM").ok().as_deref() {
+        None | Some("50") => PAPER_TUBE,
+        Some("44") => BUBBLING_TUBE,
+        Some(other) => panic!("FLUIDBED_SLUG_COLUMN_MM={other}: choose 50 (the paper's tube) or 44"),
+    }
+}
+
+/// The slugging bed at superficial velocity `u` in `tube`.
+fn case(u: f64, tube: Tube) -> Case {
     let mut c = load_case("bubbling-44mm.json");
-    c.name = format!("slug rise: 44 mm, {} mm settled, U = {u} m/s", SETTLED_M * 1e3);
-    c.column.height_m = COLUMN_M;
+    c.name = format!("slug rise: {} mm, {} mm settled, U = {u} m/s", tube.mm, SETTLED_M * 1e3);
+    c.column.height_m = tube.height_m;
+    if tube.mm != BUBBLING_TUBE.mm {
+        c.column.diameter_m = tube.mm as f64 * 1e-3;
+        c.grid.dr_m = tube.dr_m;
+        c.grid.dz_m = Some(tube.dr_m / 2.0);
+    }
     if let Bed::Generated(g) = &mut c.bed {
         g.settled_height_m = Some(SETTLED_M);
     }
@@ -79,14 +106,14 @@ pub fn stewart_davidson(u: f64, umf: f64, d: f64) -> f64 {
 }
 
 /// Where the run at `u` is kept (`.ckpt`: its checkpoint, the last one once it has finished).
-fn cache_path(u: f64) -> String {
-    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case(u)).expect("case to JSON"));
+fn cache_path(u: f64, tube: Tube) -> String {
+    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case(u, tube)).expect("case to JSON"));
     format!("target/validate-cache/slug-rise-U{u}-{key:016x}.bin")
 }
 
-/// The finished run at `u`, if it has finished (never starts it).
-pub fn finished_at(u: f64) -> Option<Finished> {
-    let cache = cache_path(u);
+/// The finished run at `u` in `tube`, if it has finished (never starts it).
+pub fn finished_at(u: f64, tube: Tube) -> Option<Finished> {
+    let cache = cache_path(u, tube);
     let kept = bincode::deserialize::<Kept>(&std::fs::read(&cache).ok()?).ok()?;
     let bytes = std::fs::read(format!("{cache}.ckpt")).ok()?;
     let (_, _, analysis) = Simulation::analysis_of_checkpoint(&bytes, None).ok()?;
@@ -94,11 +121,11 @@ pub fn finished_at(u: f64) -> Option<Finished> {
 }
 
 /// The run at `u`, from the cache, resumed from its checkpoint or run now.
-fn run_at(u: f64) -> Finished {
-    let case = case(u);
-    let cache = cache_path(u);
+fn run_at(u: f64, tube: Tube) -> Finished {
+    let case = case(u, tube);
+    let cache = cache_path(u, tube);
     let ckpt = format!("{cache}.ckpt");
-    if let Some(done) = finished_at(u) {
+    if let Some(done) = finished_at(u, tube) {
         eprintln!("[slug-rise U={u}] using the run kept in {cache} and {ckpt} (delete them to run again)");
         return done;
     }
@@ -123,7 +150,7 @@ fn run_at(u: f64) -> Finished {
         let ms = (s.time_s * 1000.0).round() as i64;
         if ms > (END_S * 1000.0) as i64 - 60 && ms % 20 == 0 {
             let eps = s.voidage.as_ref().expect("voidage field");
-            crate::plots::voidage_slice(&s, eps, &format!("docs/img/slug_rise_44mm_160mm_U{u}_{ms:04}ms.png"));
+            crate::plots::voidage_slice(&s, eps, &format!("docs/img/slug_rise_{}mm_160mm_U{u}_{ms:04}ms.png", tube.mm));
         }
         if s.index % 5 == 0 {
             let wall = wall_before + t0.elapsed().as_secs_f64();
@@ -154,11 +181,12 @@ fn slope(x: &[f64], y: &[f64]) -> f64 {
 }
 
 pub fn run() -> serde_json::Value {
-    let d = case(VELOCITIES[0]).column.diameter_m;
+    let tube = tube();
+    let d = case(VELOCITIES[0], tube).column.diameter_m;
     let (mut excess, mut measured, mut points) = (Vec::new(), Vec::new(), Vec::new());
     let mut worst: Option<(f64, f64, f64)> = None;
     for u in VELOCITIES {
-        let k = run_at(u);
+        let k = run_at(u, tube);
         let rise = k.analysis.rise_velocity.as_ref();
         let r = rise.and_then(|r| r.voidage.as_ref());
         let want = stewart_davidson(u, UMF, d);
