@@ -83,6 +83,12 @@ pub fn run() -> serde_json::Value {
     out["dp_std_rel_err"] = json!(rel(st.std, std_want));
     out["dominant_frequency_hz"] = json!(f_dom);
     out["dominant_frequency_rel_err"] = json!(rel(f_dom, f1));
+    // The first 2 s alone (a slugging run's window: too short for Welch's segments to resolve a
+    // few hertz): the peak of the whole record's periodogram.
+    let f_2s = fluidbed_core::analysis::peak_frequency(&dp[..(2.0 / dt) as usize], dt).unwrap();
+    eprintln!("ΔP's first 2 s: periodogram peak {f_2s:.4} Hz (put in {f1})");
+    out["peak_frequency_2s_hz"] = json!(f_2s);
+    out["peak_frequency_2s_rel_err"] = json!(rel(f_2s, f1));
     out["psd_peak_power_pa2"] = json!(peak_power);
     out["psd_peak_power_rel_err"] = json!(rel(peak_power, a1 * a1 / 2.0));
     out["psd_total_power_rel_err"] = json!(rel(total_power, std_want * std_want));

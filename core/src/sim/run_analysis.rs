@@ -13,7 +13,7 @@
 //! rise velocity searches delays up to half the record.
 
 use crate::analysis::{
-    axial_map, bed_pressure_drop, count_bubbles, dominant_frequency, eruption_link, layer_means, radial_profile,
+    axial_map, bed_pressure_drop, count_bubbles, eruption_link, layer_means, peak_frequency, radial_profile,
     rise_velocity, signal_stats, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, EruptionLink, FieldAverage,
     LayerSeries, ParticleAverage, RadialProfile, RiseVelocity, Spectrum,
 };
@@ -82,6 +82,8 @@ pub struct AnalysisReport {
 pub struct PressureDropStats {
     pub mean_pa: f64,
     pub std_pa: f64,
+    /// The highest peak of the whole window's periodogram (analysis/peak_frequency.rs), at or
+    /// above one cycle per window; `spectrum` (Welch's, smoother, coarser) is for the plot.
     pub dominant_frequency_hz: Option<f64>,
     pub spectrum: Option<Spectrum>,
 }
@@ -176,7 +178,7 @@ impl RunAnalysis {
             PressureDropStats {
                 mean_pa: st.mean,
                 std_pa: st.std,
-                dominant_frequency_hz: spectrum.as_ref().and_then(dominant_frequency),
+                dominant_frequency_hz: peak_frequency(dp, dt),
                 spectrum,
             }
         });
