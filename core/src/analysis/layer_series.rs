@@ -55,6 +55,15 @@ impl LayerSeries {
         self.rows.chunks(self.nz).map(|r| r[k]).collect()
     }
 
+    /// The bed surface at each sample: the top (k + 1)·dz of the highest layer whose mean is below
+    /// `below` (0 when none is), the instantaneous form of the run analysis's bed height.
+    pub fn surface_heights(&self, below: f64) -> Vec<f64> {
+        self.rows
+            .chunks(self.nz)
+            .map(|r| r.iter().rposition(|&e| e < below).map_or(0.0, |k| (k + 1) as f64 * self.dz))
+            .collect()
+    }
+
     /// Centre height (k + ½) dz of layer k.
     pub fn layer_height(&self, k: usize) -> f64 {
         (k as f64 + 0.5) * self.dz
@@ -84,5 +93,21 @@ mod tests {
         assert_eq!(ls.at_height(0.015), want);
         assert_eq!(ls.at_height(9.0), ls.layer(2));
         assert!((ls.layer_height(2) - 0.025).abs() < 1e-12);
+    }
+
+    #[test]
+    fn the_surface_is_the_top_of_the_highest_layer_below_the_threshold() {
+        // Three layers of 10 mm: dense below, the top one dense at sample 1 only, all gas at 2;
+        // a dense layer above a gap (a plug over a slug) sets the surface.
+        let g = CylGrid::new(0.01, 0.03, 0.005, 0.01, 2);
+        let per = g.cells_per_layer();
+        let mut ls = LayerSeries::new(&g);
+        for layers in [[0.4, 0.4, 0.95], [0.4, 0.5, 0.6], [1.0, 1.0, 1.0], [0.4, 0.9, 0.5]] {
+            let f: Vec<f64> = (0..g.num_cells()).map(|c| layers[c / per]).collect();
+            ls.add_sample(0.0, &f);
+        }
+        let h = ls.surface_heights(0.8);
+        let want = [0.02, 0.03, 0.0, 0.03];
+        assert!(h.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12), "{h:?}");
     }
 }

@@ -5,7 +5,8 @@
 //! 0.5 s long, bins of 2 Hz, and a bed's 1–3 Hz pressure oscillation falls in its first bin,
 //! where `dominant_frequency` cannot refine it. Over the whole record the main lobe of a tone is
 //! 4/T wide and its centre is located to a small fraction of that when one tone dominates.
-//! Peaks below one cycle per record (f < 1/T) are not frequencies of the record and are skipped.
+//! Peaks below two cycles per record (f < 2/T) are skipped: that is the half-width of the Hann
+//! window's main lobe, where what is left of the mean and any slow drift of the record leak.
 
 use super::spectrum::parabola_vertex;
 use rustfft::num_complex::Complex;
@@ -16,7 +17,7 @@ use std::f64::consts::PI;
 const PAD: usize = 8;
 const MAX_LEN: usize = 1 << 22;
 
-/// The frequency (Hz) of the highest peak at or above one cycle per record of `x` sampled every
+/// The frequency (Hz) of the highest peak at or above two cycles per record of `x` sampled every
 /// `dt` s. `None` for fewer than 8 samples or a record without variation.
 pub fn peak_frequency(x: &[f64], dt: f64) -> Option<f64> {
     let n = x.len();
@@ -34,8 +35,8 @@ pub fn peak_frequency(x: &[f64], dt: f64) -> Option<f64> {
     FftPlanner::<f64>::new().plan_fft_forward(len).process(&mut buf);
     let power: Vec<f64> = buf[..=len / 2].iter().map(|c| c.norm_sqr()).collect();
     let df = 1.0 / (len as f64 * dt);
-    // The first padded bin at one cycle per record, T = n·dt.
-    let first = ((1.0 / (n as f64 * dt)) / df).ceil().max(1.0) as usize;
+    // The first padded bin at two cycles per record, T = n·dt.
+    let first = ((2.0 / (n as f64 * dt)) / df).ceil().max(1.0) as usize;
     let (k, &pk) = (first..power.len() - 1)
         .filter(|&k| power[k] >= power[k - 1] && power[k] >= power[k + 1])
         .map(|k| (k, &power[k]))
@@ -98,11 +99,11 @@ mod tests {
     }
 
     #[test]
-    fn below_one_cycle_per_record_or_without_variation_there_is_no_peak() {
-        // A 0.3-Hz swing over 2 s (0.6 cycle) beside a 4-Hz tone: the tone is the answer.
+    fn below_two_cycles_per_record_or_without_variation_there_is_no_peak() {
+        // A 0.3-Hz swing over 2 s (0.6 cycle) and a drift beside a 4-Hz tone: the tone is the answer.
         let x: Vec<f64> = (0..1000)
             .map(|i| i as f64 * 0.002)
-            .map(|t| 80.0 * (2.0 * PI * 0.3 * t).sin() + 10.0 * (2.0 * PI * 4.0 * t).sin())
+            .map(|t| 80.0 * (2.0 * PI * 0.3 * t).sin() + 30.0 * t + 10.0 * (2.0 * PI * 4.0 * t).sin())
             .collect();
         assert!((peak_frequency(&x, 0.002).unwrap() / 4.0 - 1.0).abs() < 0.02);
         assert!(peak_frequency(&[5.0; 100], 0.01).is_none());

@@ -83,7 +83,7 @@ pub struct PressureDropStats {
     pub mean_pa: f64,
     pub std_pa: f64,
     /// The highest peak of the whole window's periodogram (analysis/peak_frequency.rs), at or
-    /// above one cycle per window; `spectrum` (Welch's, smoother, coarser) is for the plot.
+    /// above two cycles per window; `spectrum` (Welch's, smoother, coarser) is for the plot.
     pub dominant_frequency_hz: Option<f64>,
     pub spectrum: Option<Spectrum>,
 }
@@ -105,6 +105,13 @@ pub struct Eruptions {
     pub link: EruptionLink,
     /// ΔP's dominant frequency over the eruption rate (1: one ΔP cycle per eruption).
     pub dp_frequency_per_eruption: Option<f64>,
+    /// The dominant frequency of the bed surface's height (the top of the highest layer below
+    /// voidage 0.8 at each sample), which falls once at each eruption: a rate without thresholds
+    /// and resolved over the whole window (analysis/peak_frequency.rs).
+    pub surface_frequency_hz: Option<f64>,
+    /// ΔP's dominant frequency over the surface's (½: one ΔP period per pair of eruptions, the
+    /// paper's Fig. 9).
+    pub dp_frequency_per_surface_cycle: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -255,7 +262,16 @@ impl RunAnalysis {
         let rate = fronts.count.per_second;
         let link = eruption_link(dp, &fronts.count.fronts_s, dt, (1.0 / rate).min(0.5))?;
         let dp_frequency_per_eruption = dp_hz.map(|f| f / rate);
-        Some(Eruptions { fronts, link, dp_frequency_per_eruption })
+        let surface = self.voidage_layers.surface_heights(BED_VOIDAGE).split_off(skip);
+        let surface_frequency_hz = peak_frequency(&surface, dt);
+        let dp_frequency_per_surface_cycle = dp_hz.zip(surface_frequency_hz).map(|(f, s)| f / s);
+        Some(Eruptions {
+            fronts,
+            link,
+            dp_frequency_per_eruption,
+            surface_frequency_hz,
+            dp_frequency_per_surface_cycle,
+        })
     }
 }
 
@@ -399,6 +415,14 @@ mod tests {
     /// triggered average is 10 sin(2π·10 τ): swing 20 Pa, and one ΔP cycle per eruption.
     #[test]
     fn eruptions_at_the_surface_are_counted_and_linked_to_the_pressure_drop() {
+        // ΔP at the eruption rate (10 Hz) and at half of it (the paper's pair of eruptions per
+        // ΔP period).
+        for dp_hz in [10.0, 5.0] {
+            eruptions_with_dp_at(dp_hz);
+        }
+    }
+
+    fn eruptions_with_dp_at(dp_hz: f64) {
         let (mut a, grid) = small_column(1e-3, 0.05, 0.002);
         let n = grid.num_cells();
         let none: Vec<[f64; 3]> = vec![];
@@ -415,7 +439,7 @@ mod tests {
                     _ => 0.4,
                 })
                 .collect();
-            let dp = 100.0 + 10.0 * (2.0 * PI * 10.0 * t).sin();
+            let dp = 100.0 + 10.0 * (2.0 * PI * dp_hz * t).sin();
             add_sample(&mut a, &grid, t, &eps, dp, [&none, &none]);
         }
         let r = a.report(&grid);
@@ -425,8 +449,16 @@ mod tests {
         let count = &e.fronts.count;
         assert_eq!(count.bubbles, 20, "{:?}", count.fronts_s);
         assert!((count.per_second - 10.0).abs() < 0.1, "{}", count.per_second);
-        assert!((e.link.swing_pa - 20.0).abs() < 0.2, "swing {}", e.link.swing_pa);
+        if dp_hz == 10.0 {
+            assert!((e.link.swing_pa - 20.0).abs() < 0.2, "swing {}", e.link.swing_pa);
+        }
+        let want = dp_hz / 10.0;
         let ratio = e.dp_frequency_per_eruption.expect("ratio");
-        assert!((ratio - 1.0).abs() < 0.05, "ΔP cycles per eruption {ratio}");
+        assert!((ratio - want).abs() < 0.05 * want, "ΔP cycles per eruption {ratio}");
+        // The surface drops from 12 to 8 mm for 0.03 s of every 0.1 s: 10 Hz.
+        let surface = e.surface_frequency_hz.expect("surface frequency");
+        assert!((surface / 10.0 - 1.0).abs() < 0.01, "surface {surface} Hz");
+        let per_cycle = e.dp_frequency_per_surface_cycle.expect("per surface cycle");
+        assert!((per_cycle / want - 1.0).abs() < 0.02, "ΔP cycles per surface cycle {per_cycle}");
     }
 }
