@@ -177,6 +177,11 @@ fn print_analysis(a: &serde_json::Value) {
         num(&e["dp_frequency_per_eruption"]),
         num(&e["link"]["swing_pa"])
     );
+    println!(
+        "bed surface falls {} times per second, {} ΔP cycles per surface fall",
+        num(&e["surface_frequency_hz"]),
+        num(&e["dp_frequency_per_surface_cycle"])
+    );
 }
 
 async fn dispatch(cli: Cli) -> i32 {
