@@ -79,11 +79,11 @@ fn case(u: f64, tube: Tube) -> Case {
     let mut c = load_case("bubbling-44mm.json");
     c.name = format!("slug rise: {} mm, {} mm settled, U = {u} m/s", tube.mm, SETTLED_M * 1e3);
     c.column.height_m = tube.height_m;
-    if tube.mm != BUBBLING_TUBE.mm {
-        c.column.diameter_m = tube.mm as f64 * 1e-3;
-        c.grid.dr_m = tube.dr_m;
-        c.grid.dz_m = Some(tube.dr_m / 2.0);
-    }
+    // For the 44-mm tube these are the bubbling case's own values (the same doubles, so the same
+    // case JSON and cache key as before the tubes were chosen).
+    c.column.diameter_m = tube.mm as f64 * 1e-3;
+    c.grid.dr_m = tube.dr_m;
+    c.grid.dz_m = Some(tube.dr_m / 2.0);
     if let Bed::Generated(g) = &mut c.bed {
         g.settled_height_m = Some(SETTLED_M);
     }

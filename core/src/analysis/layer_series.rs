@@ -1,6 +1,7 @@
 //! Cross-section means per layer over time (voidage or pressure): one row of `nz` layer means per
 //! sample, the input of `count_bubbles` and `rise_velocity` at chosen heights.
 
+use super::layers::surface_height;
 use crate::grid::CylGrid;
 use serde::{Deserialize, Serialize};
 
@@ -58,10 +59,7 @@ impl LayerSeries {
     /// The bed surface at each sample: the top (k + 1)·dz of the highest layer whose mean is below
     /// `below` (0 when none is), the instantaneous form of the run analysis's bed height.
     pub fn surface_heights(&self, below: f64) -> Vec<f64> {
-        self.rows
-            .chunks(self.nz)
-            .map(|r| r.iter().rposition(|&e| e < below).map_or(0.0, |k| (k + 1) as f64 * self.dz))
-            .collect()
+        self.rows.chunks(self.nz).map(|r| surface_height(r, below, self.dz).unwrap_or(0.0)).collect()
     }
 
     /// Centre height (k + ½) dz of layer k.

@@ -8,6 +8,12 @@ pub fn layer_means(grid: &CylGrid, field: &[f64]) -> Vec<f64> {
     field.chunks(per).map(|l| l.iter().sum::<f64>() / per as f64).collect()
 }
 
+/// The bed surface from layer means of the voidage: the top (k + 1)·dz of the highest layer whose
+/// mean is below `below`; `None` when none is.
+pub fn surface_height(layers: &[f64], below: f64, dz: f64) -> Option<f64> {
+    layers.iter().rposition(|&e| e < below).map(|k| (k + 1) as f64 * dz)
+}
+
 /// Total pressure drop from the distributor (z = 0) to the top of the column, from layer-mean
 /// pressures L_k (centres at (k + ½)dz). The plate pressure is extrapolated as
 /// p(0) = (L0 + L1)/2 + (L0 − L2)/2, exact for a linear profile and blind to an odd–even ripple

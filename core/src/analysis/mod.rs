@@ -40,7 +40,7 @@ pub use correlation::{cross_correlation, rise_velocity, RiseVelocity};
 pub use eruptions::{eruption_link, EruptionLink};
 pub use field_average::{FieldAverage, FieldMeans};
 pub use layer_series::LayerSeries;
-pub use layers::{bed_pressure_drop, layer_means};
+pub use layers::{bed_pressure_drop, layer_means, surface_height};
 pub use particle_average::{ParticleAverage, ParticleMeans};
 pub use peak_frequency::peak_frequency;
 pub use profiles::{axial_map, radial_profile, AxialMap, RadialProfile};

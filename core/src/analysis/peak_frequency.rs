@@ -24,7 +24,8 @@ pub fn peak_frequency(x: &[f64], dt: f64) -> Option<f64> {
     if n < 8 || dt <= 0.0 {
         return None;
     }
-    let len = (PAD * n).next_power_of_two().clamp(n.next_power_of_two(), MAX_LEN.max(n.next_power_of_two()));
+    // Padded PAD times, at most MAX_LEN, never shorter than the record.
+    let len = (PAD * n).next_power_of_two().min(MAX_LEN).max(n.next_power_of_two());
     let mean = x.iter().sum::<f64>() / n as f64;
     let mut buf: Vec<Complex<f64>> = x
         .iter()

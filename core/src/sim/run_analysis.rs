@@ -14,8 +14,8 @@
 
 use crate::analysis::{
     axial_map, bed_pressure_drop, count_bubbles, eruption_link, layer_means, peak_frequency, radial_profile,
-    rise_velocity, signal_stats, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, EruptionLink, FieldAverage,
-    LayerSeries, ParticleAverage, RadialProfile, RiseVelocity, Spectrum,
+    rise_velocity, signal_stats, surface_height, welch, AxialMap, BubbleCount, BubbleFraction, ByHeight, EruptionLink,
+    FieldAverage, LayerSeries, ParticleAverage, RadialProfile, RiseVelocity, Spectrum,
 };
 use crate::case::{AnalysisSpec, Case};
 use crate::grid::CylGrid;
@@ -195,10 +195,7 @@ impl RunAnalysis {
         let weights = particles.weights();
         let particle_velocity_map = axial_map(grid, &particles.vz(), Some(&weights));
         let layer_voidage = layer_means(grid, &fields.voidage);
-        let bed_height_m = (self.samples() > 0)
-            .then(|| layer_voidage.iter().rposition(|&e| e < BED_VOIDAGE))
-            .flatten()
-            .map(|k| (k + 1) as f64 * grid.dz);
+        let bed_height_m = (self.samples() > 0).then(|| surface_height(&layer_voidage, BED_VOIDAGE, grid.dz)).flatten();
         let rise_heights = self.spec.rise_heights_m.or(bed_height_m.map(|h| [0.3 * h, 0.7 * h]));
         let bubbles = rise_heights.and_then(|[lo, _]| self.bubbles_at(lo, dt, skip));
         let rise_velocity = rise_heights.map(|[lo, hi]| {
