@@ -208,6 +208,16 @@ impl GasSolver {
     pub fn set_time_scheme(&mut self, scheme: TimeScheme) {
         self.scheme = scheme;
     }
+    /// Change the time scheme during a run: the multistep history starts again (Heun, or AB1 for
+    /// the forward–backward step's other terms), since the two schemes store different right-hand
+    /// sides (the forward–backward history lacks the pressure force), and so does the mass budget.
+    pub fn switch_time_scheme(&mut self, scheme: TimeScheme) {
+        if scheme != self.scheme {
+            self.scheme = scheme;
+            self.st.hist_len = 0;
+            self.budget = MassBudget::default();
+        }
+    }
     pub fn time_scheme(&self) -> TimeScheme {
         self.scheme
     }

@@ -190,7 +190,7 @@ impl Simulation {
         g.time_scheme = scheme;
         let inflow = crate::cfd::case_stable_time_step(&self.st.case).unwrap_or(f64::INFINITY);
         if let Some(gas) = self.st.gas.as_mut() {
-            gas.set_time_scheme(scheme);
+            gas.switch_time_scheme(scheme);
             let stable = gas.stable_dt().min(inflow);
             self.st.plan = Plan::for_case(&self.st.case, self.st.dem.len(), Some(stable));
             // `sync_gas` counts gas steps of the plan's length: recount the steps taken in it.

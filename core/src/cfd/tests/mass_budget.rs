@@ -104,3 +104,26 @@ fn the_budget_continues_across_a_checkpoint_and_a_wrong_one_shows() {
     let e = b.mass_balance().relative_error();
     assert!((e - 1e-6).abs() < 1e-12, "error {e:.3e}, 1e-6 put in");
 }
+
+#[test]
+fn a_scheme_switched_during_a_run_starts_its_history_again_and_the_budget_closes() {
+    use crate::cfd::TimeScheme;
+    for (from, to) in [(TimeScheme::Ab3, TimeScheme::ForwardBackward), (TimeScheme::ForwardBackward, TimeScheme::Ab3)] {
+        let mut a = fed_bed(Outlet::Characteristic);
+        a.set_time_scheme(from);
+        run(&mut a, 200, 0);
+        // Kept, the other scheme's history would enter the new steps: the budget shows it.
+        let mut kept = a.clone();
+        kept.set_time_scheme(to);
+        let wrong = run(&mut kept, 200, 200);
+        a.switch_time_scheme(to);
+        let worst = run(&mut a, 200, 200);
+        assert_eq!(a.time_scheme(), to);
+        assert!(worst < 1e-13, "{from:?} → {to:?}: budget error {worst:.3e}");
+        // (AB3 reads the forward–backward history's momentum without its pressure force.)
+        if from == TimeScheme::ForwardBackward {
+            assert!(wrong > 1e-9, "the kept history went unseen: {wrong:.3e}");
+        }
+        eprintln!("{from:?} → {to:?}: history kept {wrong:.2e}, started again {worst:.2e}");
+    }
+}
