@@ -176,7 +176,13 @@ pub fn run() {
         dem_round(&mut alone, ROUND, &mut ta);
         coupled_round(&mut default, ROUND, &mut td);
         coupled_round(&mut paper, ROUND, &mut tp);
-        let extra = [(&mut long, &mut tl), (&mut follow, &mut tf), (&mut follow_long, &mut tfl), (&mut mean, &mut tm), (&mut ab3, &mut tab3)];
+        let extra = [
+            (&mut long, &mut tl),
+            (&mut follow, &mut tf),
+            (&mut follow_long, &mut tfl),
+            (&mut mean, &mut tm),
+            (&mut ab3, &mut tab3),
+        ];
         for ((sim, t), stop) in extra.into_iter().zip(stopped.iter_mut()) {
             if stop.is_none() {
                 *stop = try_coupled_round(sim, ROUND, t).err();

@@ -98,6 +98,66 @@ impl SplitTwo {
     }
 }
 
+/// `interval_split` when dl < h ≤ 2·dl (a cube side across thin layers): at most three cells,
+/// given as three (cell, share) pairs, without branches; the constants as in `SplitTwo`.
+#[derive(Clone, Copy, Debug)]
+pub struct SplitThree {
+    low_end: f64,
+    inv_dl: f64,
+    dl_over_h: f64,
+    last: f64,
+    n: usize,
+}
+
+impl SplitThree {
+    pub fn new(axis: &Axis, h: f64) -> SplitThree {
+        assert!(h <= 2.0 * axis.dl && h > 0.0, "split_three: h {h} must be in (0, 2 dl = {}]", 2.0 * axis.dl);
+        assert!(axis.n > 0 && axis.n < i32::MAX as usize, "split_three: {} cells", axis.n);
+        SplitThree {
+            low_end: axis.origin + h / 2.0,
+            inv_dl: axis.inv_dl,
+            dl_over_h: axis.dl / h,
+            last: (axis.n - 1) as f64,
+            n: axis.n,
+        }
+    }
+    /// As `SplitTwo::split`: the first cell holds min((i + 1 − f)·dl/h, 1), the next at most a
+    /// whole cell's dl/h of what is left, the third the rest; cells past the last name the last.
+    #[inline(always)]
+    pub fn split(&self, c: f64) -> [(usize, f64); 3] {
+        let f = (c - self.low_end) * self.inv_dl;
+        // SAFETY: as in `SplitTwo::split`.
+        let i: i32 = unsafe { f.max(0.0).min(self.last).to_int_unchecked() };
+        let first = ((i as f64 + 1.0 - f) * self.dl_over_h).min(1.0);
+        let second = self.dl_over_h.min(1.0 - first);
+        let third = (1.0 - first - second).max(0.0);
+        let (i, top) = (i as usize, self.n - 1);
+        [(i, first), ((i + 1).min(top), second), ((i + 2).min(top), third)]
+    }
+}
+
+/// The split of a cube side along one axis into a fixed number of (cell, share) pairs.
+pub trait FixedSplit: Copy {
+    type Pairs: AsRef<[(usize, f64)]>;
+    fn pairs(&self, c: f64) -> Self::Pairs;
+}
+
+impl FixedSplit for SplitTwo {
+    type Pairs = [(usize, f64); 2];
+    #[inline(always)]
+    fn pairs(&self, c: f64) -> Self::Pairs {
+        self.split(c)
+    }
+}
+
+impl FixedSplit for SplitThree {
+    type Pairs = [(usize, f64); 3];
+    #[inline(always)]
+    fn pairs(&self, c: f64) -> Self::Pairs {
+        self.split(c)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::sphere_box::cap1;
@@ -121,17 +181,18 @@ mod tests {
 
     /// Every share is the overlap length of [c − h/2, c + h/2] with its cell over h (end cells
     /// reaching to ±∞), for cubes inside one cell, across one face and across several; the
-    /// same for `split_two` where h ≤ dl.
+    /// same for `split_two` where h ≤ dl and `split_three` where h ≤ 2 dl.
     #[test]
     fn shares_are_the_overlap_lengths() {
         let (origin, n) = (-0.5, 6);
-        for (dl, h) in [(1.375, 1.2), (0.5, 1.2), (4.4, 1.2)] {
+        for (dl, h) in [(1.375, 1.2), (0.5, 1.2), (4.4, 1.2), (0.75, 1.2), (0.6, 1.2)] {
             for k in 0..2000 {
                 let c = -1.5 + 0.00371 * k as f64;
                 let mut out = [(0, 0.0); MAX_SPAN];
                 let axis = Axis::new(origin, dl, n);
                 let m = interval_split(c, h, &axis, &mut out);
                 let two = if h <= dl { SplitTwo::new(&axis, h).split(c) } else { [(0, 0.0); 2] };
+                let three = if h <= 2.0 * dl { SplitThree::new(&axis, h).split(c) } else { [(0, 0.0); 3] };
                 for cell in 0..n {
                     let lo = if cell == 0 { f64::NEG_INFINITY } else { origin + cell as f64 * dl };
                     let hi = if cell + 1 == n { f64::INFINITY } else { origin + (cell + 1) as f64 * dl };
@@ -141,6 +202,10 @@ mod tests {
                     if h <= dl {
                         let got: f64 = two.iter().filter(|e| e.0 == cell).map(|e| e.1).sum();
                         assert!((got - want).abs() < 1e-12, "split_two: dl {dl} c {c} cell {cell}: {got} vs {want}");
+                    }
+                    if h <= 2.0 * dl {
+                        let got: f64 = three.iter().filter(|e| e.0 == cell).map(|e| e.1).sum();
+                        assert!((got - want).abs() < 1e-12, "split_three: dl {dl} c {c} cell {cell}: {got} vs {want}");
                     }
                 }
             }

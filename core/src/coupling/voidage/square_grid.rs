@@ -3,7 +3,7 @@
 //! or exactly (PHYSICS.md 3), then mapped to the cells with the box→cell fractions of `BoxGrid`.
 
 use super::box_grid::BoxGrid;
-use super::cuboid::{interval_split, Axis, SplitTwo, MAX_SPAN};
+use super::cuboid::{interval_split, Axis, FixedSplit, SplitThree, SplitTwo, MAX_SPAN};
 use super::sphere_box::sphere_box_volume;
 use super::{Scatter, VoidageMethod};
 use crate::case::BoxSplit;
@@ -126,6 +126,19 @@ fn two_stage_cuboid(
             );
             return;
         }
+        if h <= bg.dl && h <= 2.0 * g.dz {
+            // Layers thinner than the cube (drag-voidage sub-layers): 2 × 2 × 3 boxes.
+            deposit_cubes_on_thin_layers(
+                &positions[lo..hi],
+                SplitTwo::new(&across, h),
+                SplitThree::new(&up, h),
+                nb,
+                base,
+                vp,
+                buf,
+            );
+            return;
+        }
         for p in &positions[lo..hi] {
             let nx = interval_split(p[0], h, &across, &mut fx);
             let ny = interval_split(p[1], h, &across, &mut fy);
@@ -188,23 +201,29 @@ per_isa!(
     (positions: &[[f64; 3]], across: SplitTwo, up: SplitTwo, nb: usize, base: usize, vp: f64, buf: &mut [f64])
 );
 
-/// Each particle's cube (side h ≤ the box side and the layer height) onto its 2 × 2 × 2 boxes of
-/// `buf` (layer-major, rows of `nb` boxes, the column's box index less `base`): per layer and row
-/// the two boxes are neighbours.
+per_isa!(
+    /// `deposit_small_cubes` for layers thinner than the cube (h ≤ 2 dz), on the best vector path.
+    fn deposit_cubes_on_thin_layers, thin_layer_paths, deposit_small_cubes,
+    (positions: &[[f64; 3]], across: SplitTwo, up: SplitThree, nb: usize, base: usize, vp: f64, buf: &mut [f64])
+);
+
+/// Each particle's cube (side h ≤ the box side) onto its 2 × 2 × (2 or 3) boxes of `buf`
+/// (layer-major, rows of `nb` boxes, the column's box index less `base`), the layers split by
+/// `up`: per layer and row the two boxes are neighbours.
 #[inline(always)]
-fn deposit_small_cubes(
+fn deposit_small_cubes<Z: FixedSplit>(
     positions: &[[f64; 3]],
     across: SplitTwo,
-    up: SplitTwo,
+    up: Z,
     nb: usize,
     base: usize,
     vp: f64,
     buf: &mut [f64],
 ) {
     for p in positions {
-        let ([(x0, wx0), (x1, wx1)], [(y0, wy0), (y1, wy1)], [(k0, wz0), (k1, wz1)]) =
-            (across.split(p[0]), across.split(p[1]), up.split(p[2]));
-        for (k, wz) in [(k0, vp * wz0), (k1, vp * wz1)] {
+        let ([(x0, wx0), (x1, wx1)], [(y0, wy0), (y1, wy1)]) = (across.split(p[0]), across.split(p[1]));
+        for &(k, wz) in up.pairs(p[2]).as_ref() {
+            let wz = vp * wz;
             for (by, w) in [(y0, wz * wy0), (y1, wz * wy1)] {
                 let row = (k * nb + by) * nb - base;
                 buf[row + x0] += w * wx0;
@@ -291,28 +310,35 @@ mod two_stage_tests {
 
     #[test]
     fn two_stage_equals_the_per_particle_split() {
-        let g = CylGrid::new(0.022, 0.0264, 0.0044, 0.0044, 3);
-        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
-        let pos: Vec<[f64; 3]> = (0..6000)
-            .map(|_| {
-                let (r, t) = (0.0214 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
-                [r * t.cos(), r * t.sin(), rng.gen_range(0.0006..0.0258)]
-            })
-            .collect();
-        let (radius, h) = (0.0006, 0.0012);
-        let mut sg = SquareGrid::new(&g, 0.001375, BoxSplit::Cuboid, 1.0);
-        let mut fast = vec![0.0; g.num_cells()];
-        sg.solid_volume(&pos, radius, &mut fast);
-        let mut slow = vec![0.0; g.num_cells()];
-        for p in &pos {
-            cuboid_particle(&g, &sg.boxes, p, radius, h, &mut slow);
+        // (layer height, box side, cube side factor): the general path (cube 1.2 mm over 1.375-mm
+        // boxes), the 2 × 2 × 2 path, and the 2 × 2 × 3 path of layers thinner than the cube
+        // (8 drag-voidage sub-layers of 4.4 mm).
+        for (dz, side, f) in [(0.0044, 0.001375, 1.0), (0.0022, 0.0008, 0.66), (0.00055, 0.0008, 0.66)] {
+            let g = CylGrid::new(0.022, 0.0264, 0.0044, dz, 3);
+            let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+            let pos: Vec<[f64; 3]> = (0..6000)
+                .map(|_| {
+                    let (r, t) = (0.0214 * rng.gen::<f64>().sqrt(), rng.gen_range(0.0..2.0 * PI));
+                    [r * t.cos(), r * t.sin(), rng.gen_range(0.0006..0.0258)]
+                })
+                .collect();
+            let radius = 0.0006;
+            let h = f * 2.0 * radius;
+            let mut sg = SquareGrid::new(&g, side, BoxSplit::Cuboid, f);
+            let mut fast = vec![0.0; g.num_cells()];
+            sg.solid_volume(&pos, radius, &mut fast);
+            let mut slow = vec![0.0; g.num_cells()];
+            for p in &pos {
+                cuboid_particle(&g, &sg.boxes, p, radius, h, &mut slow);
+            }
+            let vp = 4.0 / 3.0 * PI * radius.powi(3);
+            for c in 0..g.num_cells() {
+                let tol = 1e-12 * vp * pos.len() as f64;
+                assert!((fast[c] - slow[c]).abs() < tol, "dz {dz}, cell {c}: {} vs {}", fast[c], slow[c]);
+            }
+            let total: f64 = fast.iter().sum();
+            assert!((total / (vp * pos.len() as f64) - 1.0).abs() < 1e-12, "dz {dz}");
         }
-        let vp = 4.0 / 3.0 * PI * radius.powi(3);
-        for c in 0..g.num_cells() {
-            assert!((fast[c] - slow[c]).abs() < 1e-12 * vp * pos.len() as f64, "cell {c}: {} vs {}", fast[c], slow[c]);
-        }
-        let total: f64 = fast.iter().sum();
-        assert!((total / (vp * pos.len() as f64) - 1.0).abs() < 1e-12);
     }
 
     #[test]
@@ -338,6 +364,16 @@ mod two_stage_tests {
         assert!(best.iter().zip(&portable).all(|(a, b)| a.to_bits() == b.to_bits()));
         let total: f64 = best.iter().sum();
         assert!((total - pos.len() as f64).abs() < 1e-9, "volume {total}");
+        // Layers thinner than the cube (2 × 2 × 3).
+        let thin = CylGrid::new(0.022, 0.0264, 0.0044, 0.00055, 3);
+        let up = SplitThree::new(&Axis::new(0.0, thin.dz, thin.nz), h);
+        let mut best = vec![0.0; bg.nb * bg.nb * thin.nz];
+        let mut portable = best.clone();
+        deposit_cubes_on_thin_layers(&pos, across, up, bg.nb, 0, 1.0, &mut best);
+        deposit_small_cubes(&pos, across, up, bg.nb, 0, 1.0, &mut portable);
+        assert!(best.iter().zip(&portable).all(|(a, b)| a.to_bits() == b.to_bits()));
+        let total: f64 = best.iter().sum();
+        assert!((total - pos.len() as f64).abs() < 1e-9, "thin layers: volume {total}");
     }
 
     #[test]
