@@ -140,6 +140,7 @@ pub struct Exchange {
     /// Sub-layers: the pressure correction the gas loses per sub-cell, and scratch (sublayer_pressure.rs).
     sub_lost: Vec<[f64; 3]>,
     sub_scratch: Vec<[f64; 3]>,
+    sub_count: Vec<u32>,
     /// `carry_hints`' cell per particle identity.
     cell_by_id: Vec<u32>,
     /// The particles' identities in their order at the last call, and the caller's count of
@@ -172,6 +173,7 @@ impl Exchange {
             chunk_force: vec![vec![[0.0; 3]; grid.num_cells()]; CHUNKS],
             sub_lost: Vec::new(),
             sub_scratch: Vec::new(),
+            sub_count: Vec::new(),
             cell_by_id: Vec::new(),
             hint_ids: Vec::new(),
             hint_order: 0,
@@ -230,8 +232,8 @@ impl Exchange {
         assert!(drag.grid.cells_per_layer() == per && drag_cells == m * cells && drag.voidage.len() == drag_cells);
         self.cell_of.resize(pos.len(), 0);
         // The drag cells of the layers that hold particles; the cells above get no table and no
-        // force. (Sub-layers read their neighbours' sums: all of them.)
-        let used = if m == 1 { gas.layers.min(grid.nz) * per } else { drag_cells };
+        // force (the sub-layers' pressure share reads their sums as the zeros they are).
+        let used = gas.layers.min(grid.nz) * m * per;
         // 1. per drag cell (parallel): everything that does not depend on the particle
         let (mu, d) = (par.mu, par.d);
         table.resize(drag_cells, CellTable::default());
@@ -291,6 +293,7 @@ impl Exchange {
         if m > 1 {
             let d = SubLayerDrag {
                 sums: &self.chunk_force,
+                used,
                 voidage: drag.voidage,
                 eps_min: par.eps_min,
                 cell_of: &self.cell_of,
@@ -300,7 +303,7 @@ impl Exchange {
                 vp,
                 basis,
             };
-            add_sublayer_pressure(&d, force_out, &mut self.sub_lost, &mut self.sub_scratch);
+            add_sublayer_pressure(&d, force_out, &mut self.sub_lost, (&mut self.sub_scratch, &mut self.sub_count));
         }
         // 4. the gas loses the drag (and the sub-layers' pressure correction) in its cell: chunk
         //    sums and sub-cells in a fixed order, per unit volume

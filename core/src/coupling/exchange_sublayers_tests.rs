@@ -95,3 +95,37 @@ fn what_the_particles_gain_with_sublayers_the_gas_loses() {
         assert!((on_particles[q] + on_gas[q]).abs() < 1e-12 * scale * m as f64, "{q}: {on_particles:?} vs {on_gas:?}");
     }
 }
+
+#[test]
+fn the_layers_with_particles_give_the_same_forces_as_the_whole_column_with_sublayers() {
+    // Six fluid layers, four sub-layers each; the bed in the lower two. The call that stops at
+    // the bed's top layer gives the particles the same bits as the whole column's, and the gas
+    // the same force in every cell (none above the bed).
+    let g = CylGrid::new(0.022, 0.0264, 0.0044, 0.0044, 3);
+    let fine = CylGrid::new(0.022, 0.0264, 0.0044, 0.0011, 3);
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+    let mut scene = super::tests::RandomScene::new(&mut rng, g.num_cells(), 3000, true);
+    for p in &mut scene.pos {
+        p[2] *= 0.6;
+    }
+    let sub: Vec<f64> = (0..fine.num_cells()).map(|_| rng.gen_range(0.35..1.0)).collect();
+    let layers = layers_with_particles(&g, &scene.pos);
+    assert!(layers + 1 < g.nz, "the bed leaves layers free");
+    let par = ExchangeParams { law: DragModel::Beetstra, mu: 1.8e-5, eps_min: 0.1, d: 1.2e-3 };
+    let run = |layers: usize, ex: &mut Exchange| {
+        let (mut f, mut cf) = (vec![[0.0; 3]; scene.pos.len()], vec![[0.0; 3]; g.num_cells()]);
+        let gas = GasAtCells { layers, ..scene.gas() };
+        let drag = DragCells { grid: &fine, sublayers: 4, voidage: &sub };
+        ex.particle_gas_forces(&g, drag, &gas, par, (&scene.pos, &scene.vel), &mut f, &mut cf);
+        (f, cf)
+    };
+    let (f_all, cf_all) = run(usize::MAX, &mut Exchange::new(&g, scene.pos.len()));
+    // The same Exchange first on the whole column, so stale sums above the bed would show.
+    let mut ex = Exchange::new(&g, scene.pos.len());
+    run(usize::MAX, &mut ex);
+    let (f, cf) = run(layers, &mut ex);
+    assert!(f == f_all, "particle forces differ");
+    assert!(cf == cf_all, "gas forces differ");
+    let per = g.cells_per_layer();
+    assert!(cf[layers * per..].iter().all(|c| *c == [0.0; 3]), "force above the bed");
+}

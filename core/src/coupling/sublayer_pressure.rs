@@ -12,11 +12,15 @@
 
 use super::drag::clamp_voidage;
 use super::exchange::cyl_to_cart;
+use rayon::prelude::*;
 
 /// What the correction reads: per sub-cell the drag sums of the particle pass (cell basis, one row
 /// per chunk) and the drag voidage; the sub-cell of each particle; the geometry.
 pub(super) struct SubLayerDrag<'a> {
     pub sums: &'a [Vec<[f64; 3]>],
+    /// Sub-cells 0..used: the fluid layers that hold particles; the sums above are zero and not
+    /// read.
+    pub used: usize,
     pub voidage: &'a [f64],
     pub eps_min: f64,
     pub cell_of: &'a [u32],
@@ -30,34 +34,39 @@ pub(super) struct SubLayerDrag<'a> {
 }
 
 /// Adds V_p(G_s − G_c) to each particle's force (Cartesian) and writes Σ of it per sub-cell (cell
-/// basis) into `lost` (the gas loses it); `g` is scratch of one entry per sub-cell.
+/// basis) into `lost` (the gas loses it; sub-cells 0..used); `g` and `count` are scratch of one
+/// entry per sub-cell. The sub-cells above `used` hold no particle: their G_s never reaches one,
+/// and the windows of the ones below take their sums as zero.
 pub(super) fn add_sublayer_pressure(
     d: &SubLayerDrag,
     force: &mut [[f64; 3]],
     lost: &mut Vec<[f64; 3]>,
-    g: &mut Vec<[f64; 3]>,
+    (g, count): (&mut Vec<[f64; 3]>, &mut Vec<u32>),
 ) {
-    let cells_d = d.voidage.len();
-    let (per, layers) = (d.per, cells_d / d.per);
+    let (per, used) = (d.per, d.used);
+    let layers = d.voidage.len() / per;
     // I_s over the window of the drag voidage (the sub-cell and the ones above and below it).
-    g.resize(cells_d, [0.0; 3]);
-    for (s, gs) in g.iter_mut().enumerate() {
+    g.resize(used, [0.0; 3]);
+    g.par_iter_mut().with_min_len(1024).enumerate().for_each(|(s, gs)| {
         let k = s / per;
         let (lo, hi) = (k.saturating_sub(1), (k + 1).min(layers - 1));
         let mut sum = [0.0; 3];
         for k2 in lo..=hi {
-            for row in d.sums {
-                for q in 0..3 {
-                    sum[q] += row[s - k * per + k2 * per][q];
+            let at = s - k * per + k2 * per;
+            if at < used {
+                for row in d.sums {
+                    for q in 0..3 {
+                        sum[q] += row[at][q];
+                    }
                 }
             }
         }
         let w = 1.0 / ((hi - lo + 1) as f64 * d.v_sub * clamp_voidage(d.voidage[s], d.eps_min));
         *gs = [w * sum[0], w * sum[1], w * sum[2]];
-    }
+    });
     // G_s − G_c: the sub-cells of cell (layer k, in-layer j) are n·k·per + j + i·per, i < n.
     let n = d.n;
-    for layer in 0..cells_d / (n * per) {
+    for layer in 0..used / (n * per) {
         for j in 0..per {
             let first = layer * n * per + j;
             let mut mean = [0.0; 3];
@@ -74,16 +83,25 @@ pub(super) fn add_sublayer_pressure(
             }
         }
     }
-    lost.clear();
-    lost.resize(cells_d, [0.0; 3]);
-    for (f, &s) in force.iter_mut().zip(d.cell_of) {
+    // Every particle of sub-cell s gains the same V_p(G_s − G_c): the gas loses it once per
+    // particle there.
+    let g = &g[..];
+    force.par_iter_mut().zip(d.cell_of.par_iter()).with_min_len(4096).for_each(|(f, &s)| {
         let s = s as usize;
-        let c = [d.vp * g[s][0], d.vp * g[s][1], d.vp * g[s][2]];
         let (cos, sin) = d.basis[s % per];
-        let cart = cyl_to_cart(c, cos, sin);
+        let cart = cyl_to_cart([d.vp * g[s][0], d.vp * g[s][1], d.vp * g[s][2]], cos, sin);
         for q in 0..3 {
             f[q] += cart[q];
-            lost[s][q] += c[q];
         }
+    });
+    count.clear();
+    count.resize(used, 0);
+    for &s in d.cell_of {
+        count[s as usize] += 1;
     }
+    lost.clear();
+    lost.extend(g.iter().zip(count.iter()).map(|(gs, &k)| {
+        let c = k as f64 * d.vp;
+        [c * gs[0], c * gs[1], c * gs[2]]
+    }));
 }

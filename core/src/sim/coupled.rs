@@ -58,13 +58,14 @@ pub(super) fn sublayer_grid(grid: &CylGrid, n: usize) -> CylGrid {
 /// The window smooths the layering of particles in sub-layers thinner than a particle, which the
 /// drag law (convex in ε) would turn into extra drag (docs/VALIDATION.md).
 fn windowed_voidage(fine: &CylGrid, solid: &[f64], out: &mut [f64]) {
+    use rayon::prelude::*;
     let (per, nz, v) = (fine.cells_per_layer(), fine.nz, fine.cell_volume());
-    for (s, e) in out.iter_mut().enumerate() {
+    out.par_iter_mut().with_min_len(2048).enumerate().for_each(|(s, e)| {
         let k = s / per;
         let (lo, hi) = (k.saturating_sub(1), (k + 1).min(nz - 1));
         let sum: f64 = (lo..=hi).map(|k2| solid[s - k * per + k2 * per]).sum();
         *e = 1.0 - sum / ((hi - lo + 1) as f64 * v);
-    }
+    });
 }
 
 impl Buffers {
