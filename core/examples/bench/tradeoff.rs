@@ -11,7 +11,9 @@
 //!    the reference and the fluid layer height point alone, `sound` the reference and the acoustic
 //!    speed points (the gas's pressure waves at f = ½ and ¼ of the sound speed, each from its own
 //!    spin-up) alone, `gas-voidage` the reference and the gas's voidage extrapolated,
-//!    interpolated and held between couplings at intervals 10, 20, 50 alone.
+//!    interpolated and held between couplings at intervals 10, 20, 50 alone, `scheme` the gas's
+//!    time schemes, `pressure` the particles' pressure force held or at the interval's mean at
+//!    intervals 10 and 20.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -252,6 +254,45 @@ fn scheme_front() {
     }
 }
 
+/// `-- tradeoff pressure`: the particles' pressure force between couplings held (the paper's) or at
+/// the interval's mean (`coupling.pressure_force`), at intervals 10 and 20, each from the
+/// reference's spin-up state, against the reference and beside the noise floor.
+fn pressure_front() {
+    use fluidbed_core::case::PressureForce;
+    let (reference, floor_case) = (bed(1), bed(2));
+    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
+    let r = stats(&ref_snaps, &fluid_grid(&reference));
+    let (floor_snaps, _) = window(&floor_case, "tradeoff-seed2", 1);
+    let floor = stats(&floor_snaps, &fluid_grid(&floor_case));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
+        "errors": errors(&floor, &r), "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
+    );
+    for interval in [10, 20] {
+        for how in [PressureForce::Held, PressureForce::IntervalMean] {
+            let mut sim = Simulation::restore(&state_at(&reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
+            sim.set_coupling_interval(interval);
+            sim.set_pressure_force(how);
+            let window = window_s();
+            sim.set_end_time(SPIN_UP_S + window);
+            let (mut snaps, t0) = (Vec::new(), Instant::now());
+            while !sim.is_finished() {
+                if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
+                    snaps.push(s);
+                }
+            }
+            let cost = t0.elapsed().as_secs_f64() / window;
+            let s = stats(&snaps, &fluid_grid(&reference));
+            println!(
+                "{}",
+                json!({"bench": "tradeoff_point", "knob": "pressure_force", "setting": format!("{how:?} at interval {interval}"),
+                "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+            );
+        }
+    }
+}
+
 /// `-- tradeoff sound`: the reference window and the acoustic speed points alone.
 fn acoustic_front() {
     let reference = bed(1);
@@ -411,6 +452,10 @@ pub fn run() {
     }
     if part == "scheme" {
         scheme_front();
+        return;
+    }
+    if part == "pressure" {
+        pressure_front();
         return;
     }
     if part.is_empty() || part == "cost" {
