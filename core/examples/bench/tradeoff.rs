@@ -217,40 +217,54 @@ fn acoustic_point(reference: &Case, r: &Stats, f: f64) {
     );
 }
 
-/// `-- tradeoff scheme`: the gas's time scheme (cfd/forward_backward.rs) at the default interval,
-/// each from the reference's spin-up state, against the reference and beside the noise floor.
-fn scheme_front() {
-    let (reference, floor_case) = (bed(1), bed(2));
-    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
-    let r = stats(&ref_snaps, &fluid_grid(&reference));
-    let (floor_snaps, _) = window(&floor_case, "tradeoff-seed2", 1);
-    let floor = stats(&floor_snaps, &fluid_grid(&floor_case));
+/// The every-step reference's statistics, after printing the noise floor (the same reference from
+/// a second poured bed) against them.
+fn reference_beside_floor(reference: &Case, floor_case: &Case) -> Stats {
+    let (ref_snaps, _) = window(reference, "tradeoff-seed1", 1);
+    let r = stats(&ref_snaps, &fluid_grid(reference));
+    let (floor_snaps, _) = window(floor_case, "tradeoff-seed2", 1);
+    let floor = stats(&floor_snaps, &fluid_grid(floor_case));
     println!(
         "{}",
         json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
         "errors": errors(&floor, &r), "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
     );
+    r
+}
+
+/// One window from the reference's spin-up state with `set` applied, printed as a point of `knob`
+/// against the reference's statistics `r`.
+fn point_from_spin_up(reference: &Case, r: &Stats, knob: &str, setting: String, set: impl FnOnce(&mut Simulation)) {
+    let mut sim = Simulation::restore(&state_at(reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
+    set(&mut sim);
+    let window = window_s();
+    sim.set_end_time(SPIN_UP_S + window);
+    let (mut snaps, t0) = (Vec::new(), Instant::now());
+    while !sim.is_finished() {
+        if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
+            snaps.push(s);
+        }
+    }
+    let cost = t0.elapsed().as_secs_f64() / window;
+    let s = stats(&snaps, &fluid_grid(reference));
+    println!(
+        "{}",
+        json!({"bench": "tradeoff_point", "knob": knob, "setting": setting, "wall_s_per_sim_s": cost,
+        "errors": errors(&s, r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+    );
+}
+
+/// `-- tradeoff scheme`: the gas's time scheme (cfd/forward_backward.rs) at the default interval,
+/// each from the reference's spin-up state, against the reference and beside the noise floor.
+fn scheme_front() {
+    let reference = bed(1);
+    let r = reference_beside_floor(&reference, &bed(2));
     let interval = reference.coupling.interval_steps;
     for scheme in [TimeScheme::Ab3, TimeScheme::ForwardBackward] {
-        let state = state_at(&reference, SPIN_UP_S, "tradeoff-seed1");
-        let mut sim = Simulation::restore(&state).expect("state");
-        sim.set_coupling_interval(interval);
-        sim.set_gas_time_scheme(scheme);
-        let window = window_s();
-        sim.set_end_time(SPIN_UP_S + window);
-        let (mut snaps, t0) = (Vec::new(), Instant::now());
-        while !sim.is_finished() {
-            if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
-                snaps.push(s);
-            }
-        }
-        let cost = t0.elapsed().as_secs_f64() / window;
-        let s = stats(&snaps, &fluid_grid(&reference));
-        println!(
-            "{}",
-            json!({"bench": "tradeoff_point", "knob": "gas_time_scheme", "setting": format!("{scheme:?} at interval {interval}"),
-            "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
-        );
+        point_from_spin_up(&reference, &r, "gas_time_scheme", format!("{scheme:?} at interval {interval}"), |sim| {
+            sim.set_coupling_interval(interval);
+            sim.set_gas_time_scheme(scheme);
+        });
     }
 }
 
@@ -259,36 +273,14 @@ fn scheme_front() {
 /// reference's spin-up state, against the reference and beside the noise floor.
 fn pressure_front() {
     use fluidbed_core::case::PressureForce;
-    let (reference, floor_case) = (bed(1), bed(2));
-    let (ref_snaps, _) = window(&reference, "tradeoff-seed1", 1);
-    let r = stats(&ref_snaps, &fluid_grid(&reference));
-    let (floor_snaps, _) = window(&floor_case, "tradeoff-seed2", 1);
-    let floor = stats(&floor_snaps, &fluid_grid(&floor_case));
-    println!(
-        "{}",
-        json!({"bench": "tradeoff_point", "knob": "noise_floor", "setting": "seed 2, interval 1",
-        "errors": errors(&floor, &r), "dp_mean_pa": r.dp_mean, "dp_std_pa": r.dp_std, "dp_freq_hz": r.dp_freq})
-    );
+    let reference = bed(1);
+    let r = reference_beside_floor(&reference, &bed(2));
     for interval in [10, 20] {
         for how in [PressureForce::Held, PressureForce::IntervalMean] {
-            let mut sim = Simulation::restore(&state_at(&reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
-            sim.set_coupling_interval(interval);
-            sim.set_pressure_force(how);
-            let window = window_s();
-            sim.set_end_time(SPIN_UP_S + window);
-            let (mut snaps, t0) = (Vec::new(), Instant::now());
-            while !sim.is_finished() {
-                if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
-                    snaps.push(s);
-                }
-            }
-            let cost = t0.elapsed().as_secs_f64() / window;
-            let s = stats(&snaps, &fluid_grid(&reference));
-            println!(
-                "{}",
-                json!({"bench": "tradeoff_point", "knob": "pressure_force", "setting": format!("{how:?} at interval {interval}"),
-                "wall_s_per_sim_s": cost, "errors": errors(&s, &r), "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
-            );
+            point_from_spin_up(&reference, &r, "pressure_force", format!("{how:?} at interval {interval}"), |sim| {
+                sim.set_coupling_interval(interval);
+                sim.set_pressure_force(how);
+            });
         }
     }
 }

@@ -56,26 +56,24 @@ pub fn interval_split(c: f64, h: f64, axis: &Axis, out: &mut [(usize, f64); MAX_
     m
 }
 
-/// `interval_split` when h ≤ the cell width: the interval lies in at most two cells, given as
-/// two (cell, share) pairs (the second share 0 when it fits in one cell), without branches. The
-/// constants of the axis and h are taken once (`new`), so that a particle costs two multiplies,
-/// one truncation and no division.
+/// What a branch-free split of a cube side h along `axis` keeps: where the low end of the
+/// interval starts in cell units, (c − h/2 − origin)/dl, as low_end and 1/dl; dl/h; the index of
+/// the last cell (which reaches to +∞). Taken once per call, so that a particle costs two
+/// multiplies, one truncation and no division.
 #[derive(Clone, Copy, Debug)]
-pub struct SplitTwo {
-    /// Where the low end of the interval starts in cell units: (c − h/2 − origin)/dl.
+struct SplitConstants {
     low_end: f64,
     inv_dl: f64,
     dl_over_h: f64,
-    /// Index of the last cell, which reaches to +∞.
     last: f64,
     n: usize,
 }
 
-impl SplitTwo {
-    pub fn new(axis: &Axis, h: f64) -> SplitTwo {
-        assert!(h <= axis.dl && h > 0.0, "split_two: h {h} must be in (0, dl {}]", axis.dl);
-        assert!(axis.n > 0 && axis.n < i32::MAX as usize, "split_two: {} cells", axis.n);
-        SplitTwo {
+impl SplitConstants {
+    fn new(axis: &Axis, h: f64, cells: f64, name: &str) -> SplitConstants {
+        assert!(h <= cells * axis.dl && h > 0.0, "{name}: h {h} must be in (0, {} dl = {}]", cells, cells * axis.dl);
+        assert!(axis.n > 0 && axis.n < i32::MAX as usize, "{name}: {} cells", axis.n);
+        SplitConstants {
             low_end: axis.origin + h / 2.0,
             inv_dl: axis.inv_dl,
             dl_over_h: axis.dl / h,
@@ -84,54 +82,52 @@ impl SplitTwo {
         }
     }
     /// With f = (c − h/2 − origin)/dl the low end in cell units and i = ⌊f⌋ clamped to the
-    /// axis, the first cell holds min((i + 1 − f)·dl/h, 1) of the interval. In the last cell
-    /// both pairs name that cell, so it holds all of it (it reaches to +∞).
+    /// axis: i and the share min((i + 1 − f)·dl/h, 1) of the interval in cell i.
     #[inline(always)]
-    pub fn split(&self, c: f64) -> [(usize, f64); 2] {
+    fn first(&self, c: f64) -> (usize, f64) {
         let f = (c - self.low_end) * self.inv_dl;
         // SAFETY: the clamped value is in [0, n − 1] (a NaN clamps to 0), so it fits an i32
         // and truncation is ⌊·⌋; the checked cast costs more than the rest of the split.
         let i: i32 = unsafe { f.max(0.0).min(self.last).to_int_unchecked() };
-        let share = ((i as f64 + 1.0 - f) * self.dl_over_h).min(1.0);
-        let i = i as usize;
-        [(i, share), ((i + 1).min(self.n - 1), 1.0 - share)]
+        (i as usize, ((i as f64 + 1.0 - f) * self.dl_over_h).min(1.0))
+    }
+}
+
+/// `interval_split` when h ≤ the cell width: the interval lies in at most two cells, given as
+/// two (cell, share) pairs (the second share 0 when it fits in one cell), without branches.
+#[derive(Clone, Copy, Debug)]
+pub struct SplitTwo(SplitConstants);
+
+impl SplitTwo {
+    pub fn new(axis: &Axis, h: f64) -> SplitTwo {
+        SplitTwo(SplitConstants::new(axis, h, 1.0, "split_two"))
+    }
+    /// Cell i holds the first share, i + 1 the rest. In the last cell both pairs name that
+    /// cell, so it holds all of it (it reaches to +∞).
+    #[inline(always)]
+    pub fn split(&self, c: f64) -> [(usize, f64); 2] {
+        let (i, share) = self.0.first(c);
+        [(i, share), ((i + 1).min(self.0.n - 1), 1.0 - share)]
     }
 }
 
 /// `interval_split` when dl < h ≤ 2·dl (a cube side across thin layers): at most three cells,
-/// given as three (cell, share) pairs, without branches; the constants as in `SplitTwo`.
+/// given as three (cell, share) pairs, without branches.
 #[derive(Clone, Copy, Debug)]
-pub struct SplitThree {
-    low_end: f64,
-    inv_dl: f64,
-    dl_over_h: f64,
-    last: f64,
-    n: usize,
-}
+pub struct SplitThree(SplitConstants);
 
 impl SplitThree {
     pub fn new(axis: &Axis, h: f64) -> SplitThree {
-        assert!(h <= 2.0 * axis.dl && h > 0.0, "split_three: h {h} must be in (0, 2 dl = {}]", 2.0 * axis.dl);
-        assert!(axis.n > 0 && axis.n < i32::MAX as usize, "split_three: {} cells", axis.n);
-        SplitThree {
-            low_end: axis.origin + h / 2.0,
-            inv_dl: axis.inv_dl,
-            dl_over_h: axis.dl / h,
-            last: (axis.n - 1) as f64,
-            n: axis.n,
-        }
+        SplitThree(SplitConstants::new(axis, h, 2.0, "split_three"))
     }
-    /// As `SplitTwo::split`: the first cell holds min((i + 1 − f)·dl/h, 1), the next at most a
-    /// whole cell's dl/h of what is left, the third the rest; cells past the last name the last.
+    /// The first share in cell i, at most a whole cell's dl/h of what is left in i + 1, the rest
+    /// in i + 2; cells past the last name the last.
     #[inline(always)]
     pub fn split(&self, c: f64) -> [(usize, f64); 3] {
-        let f = (c - self.low_end) * self.inv_dl;
-        // SAFETY: as in `SplitTwo::split`.
-        let i: i32 = unsafe { f.max(0.0).min(self.last).to_int_unchecked() };
-        let first = ((i as f64 + 1.0 - f) * self.dl_over_h).min(1.0);
-        let second = self.dl_over_h.min(1.0 - first);
+        let (i, first) = self.0.first(c);
+        let second = self.0.dl_over_h.min(1.0 - first);
         let third = (1.0 - first - second).max(0.0);
-        let (i, top) = (i as usize, self.n - 1);
+        let top = self.0.n - 1;
         [(i, first), ((i + 1).min(top), second), ((i + 2).min(top), third)]
     }
 }

@@ -113,30 +113,15 @@ fn two_stage_cuboid(
         let base = k0 * nb * nb;
         let (mut fx, mut fy, mut fz) = ([(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN], [(0, 0.0); MAX_SPAN]);
         let across = Axis::new(bg.origin, bg.dl, nb);
-        if h <= bg.dl && h <= g.dz {
-            // Every cube in at most 2 × 2 × 2 boxes: eight adds, no data-dependent branch.
-            deposit_small_cubes_on(
-                &positions[lo..hi],
-                SplitTwo::new(&across, h),
-                SplitTwo::new(&up, h),
-                nb,
-                base,
-                vp,
-                buf,
-            );
-            return;
-        }
         if h <= bg.dl && h <= 2.0 * g.dz {
-            // Layers thinner than the cube (drag-voidage sub-layers): 2 × 2 × 3 boxes.
-            deposit_cubes_on_thin_layers(
-                &positions[lo..hi],
-                SplitTwo::new(&across, h),
-                SplitThree::new(&up, h),
-                nb,
-                base,
-                vp,
-                buf,
-            );
+            // Every cube in at most 2 × 2 × 2 boxes (× 3 layers thinner than the cube: drag-voidage
+            // sub-layers): eight (twelve) adds, no data-dependent branch.
+            let (cubes, across) = (&positions[lo..hi], SplitTwo::new(&across, h));
+            if h <= g.dz {
+                deposit_small_cubes_on(cubes, across, SplitTwo::new(&up, h), nb, base, vp, buf);
+            } else {
+                deposit_cubes_on_thin_layers(cubes, across, SplitThree::new(&up, h), nb, base, vp, buf);
+            }
             return;
         }
         for p in &positions[lo..hi] {
