@@ -11,7 +11,8 @@
 //! bed and the sweep (any subset of the keys; also `hold`, seconds per stage, and `dz_over_dr`,
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
 //! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` or `pressure_mean`, 1 for the
-//! case's `coupling.pressure_force` "gas_step" or "interval_mean", 0 for the case's own).
+//! case's `coupling.pressure_force` "gas_step" or "interval_mean", 0 for the case's own, and
+//! `interval`, the case's `coupling.interval_steps`).
 //! `umf-paper-cells` runs the same sweep with dz = dr, the drag voidage on 8 sub-layers per cell
 //! and the pressure force following the gas.
 
@@ -36,6 +37,8 @@ struct Sweep {
     pressure_force: Option<PressureForce>,
     /// `gas.time_scheme` "ab3", the paper's (else the case's).
     ab3: bool,
+    /// `coupling.interval_steps` (None: the case's).
+    interval: Option<u32>,
 }
 
 impl Sweep {
@@ -53,6 +56,7 @@ impl Sweep {
             sublayers: None,
             pressure_force: None,
             ab3: false,
+            interval: None,
         }
     }
 
@@ -75,7 +79,8 @@ impl Sweep {
                 "pressure_gas_step" => s.pressure_force = (x != 0.0).then_some(PressureForce::GasStep),
                 "pressure_mean" => s.pressure_force = (x != 0.0).then_some(PressureForce::IntervalMean),
                 "ab3" => s.ab3 = x != 0.0,
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, ab3)"),
+                "interval" => s.interval = Some(x as u32),
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, ab3, interval)"),
             }
         }
         s
@@ -115,6 +120,9 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     }
     if let Some(n) = sw.sublayers {
         case.coupling.drag_voidage_sublayers = n;
+    }
+    if let Some(n) = sw.interval {
+        case.coupling.interval_steps = n;
     }
     if sw.ab3 {
         case.gas.as_mut().expect("gas").time_scheme = fluidbed_core::cfd::TimeScheme::Ab3;
