@@ -210,7 +210,7 @@ fn drive(app: &Arc<App>, id: &str, cancel: &AtomicBool, lost: &AtomicBool, base_
         },
         None => {
             let case_json = app.store.case_json(id)?.unwrap_or_default();
-            let case: Case = serde_json::from_str(&case_json)?;
+            let case = Case::from_stored_json(&case_json)?;
             // A generated bed is poured and settled first (minutes for a large bed, then
             // cached): say so, since the run's progress stays at 0 meanwhile.
             let preparing = matches!(case.bed, fluidbed_core::case::Bed::Generated(_));

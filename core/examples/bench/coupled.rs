@@ -149,24 +149,28 @@ pub fn run() {
     let state = state_at(&case, FLUIDIZED_AT_S, name.trim_end_matches(".json"));
     let restore = || Simulation::restore(&state).expect("cached state");
     let (mut alone, mut default, mut paper, mut long) = (restore(), restore(), restore(), restore());
+    // The paper's coupling: every step, the pressure force of the moment.
     paper.set_coupling_interval(1);
+    paper.set_pressure_force(fluidbed_core::case::PressureForce::Held);
     // A longer interval with the gas's voidage extrapolated (docs/BENCHMARKS.md, "Run time
     // against error"): reported beside the others, not a default.
     long.set_coupling_interval(LONG_INTERVAL);
     long.set_gas_voidage(fluidbed_core::case::GasVoidage::Extrapolated);
     // The particles' pressure force following the gas (docs/VALIDATION.md, "The pressure force
-    // between couplings") at the default interval and at the longer one: not defaults.
+    // between couplings") at intervals of 10 and 20: not defaults.
     let (mut follow, mut follow_long) = (restore(), restore());
     follow.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
+    follow.set_coupling_interval(10);
     follow_long.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
     follow_long.set_coupling_interval(LONG_INTERVAL);
     // Held at the mean of the gas's gradient over the last interval (sim/pressure_mean.rs).
-    // And so at the longer interval.
-    let (mut mean, mut mean_long) = (restore(), restore());
+    // The defaults before 2026-12-06: held at an interval of 10; and the mean at 10.
+    let (mut mean, mut held_10) = (restore(), restore());
     mean.set_pressure_force(fluidbed_core::case::PressureForce::IntervalMean);
-    mean_long.set_pressure_force(fluidbed_core::case::PressureForce::IntervalMean);
-    mean_long.set_coupling_interval(LONG_INTERVAL);
-    let (mut tm, mut tml) = (Tally::default(), Tally::default());
+    mean.set_coupling_interval(10);
+    held_10.set_pressure_force(fluidbed_core::case::PressureForce::Held);
+    held_10.set_coupling_interval(10);
+    let (mut tm, mut th10) = (Tally::default(), Tally::default());
     // The gas stepped by the paper's AB3 (the default is forward–backward) at the default interval.
     let mut ab3 = restore();
     ab3.set_gas_time_scheme(fluidbed_core::cfd::TimeScheme::Ab3);
@@ -185,7 +189,7 @@ pub fn run() {
             (&mut follow_long, &mut tfl),
             (&mut mean, &mut tm),
             (&mut ab3, &mut tab3),
-            (&mut mean_long, &mut tml),
+            (&mut held_10, &mut th10),
         ];
         for ((sim, t), stop) in extra.into_iter().zip(stopped.iter_mut()) {
             if stop.is_none() {
@@ -198,18 +202,17 @@ pub fn run() {
     let share = |t: &Tally| 1.0 - ta.per_step() / t.per_step();
     let long_name = format!("extrapolated_interval_{LONG_INTERVAL}");
     let follow_long_name = format!("pressure_force_gas_step_interval_{LONG_INTERVAL}");
-    let mean_long_name = format!("pressure_force_interval_mean_interval_{LONG_INTERVAL}");
     let none = None;
     let modes = [
         ("dem_alone", &ta, &none),
         ("default", &td, &none),
         ("paper", &tp, &none),
         (long_name.as_str(), &tl, &stopped[0]),
-        ("pressure_force_gas_step", &tf, &stopped[1]),
+        ("pressure_force_gas_step_interval_10", &tf, &stopped[1]),
         (follow_long_name.as_str(), &tfl, &stopped[2]),
-        ("pressure_force_interval_mean", &tm, &stopped[3]),
+        ("pressure_force_interval_mean_interval_10", &tm, &stopped[3]),
         ("gas_ab3", &tab3, &stopped[4]),
-        (mean_long_name.as_str(), &tml, &stopped[5]),
+        ("held_interval_10", &th10, &stopped[5]),
     ];
     for (name, t, stop) in modes {
         println!(

@@ -148,6 +148,10 @@ fn window_as(case: &Case, label: &str, interval: u32, how: GasVoidage) -> (Vec<S
     let mut sim = Simulation::restore(&state).expect("state");
     sim.set_coupling_interval(interval);
     sim.set_gas_voidage(how);
+    if interval == 1 {
+        // The reference is the paper's coupling: every step, the pressure force of the moment.
+        sim.set_pressure_force(fluidbed_core::case::PressureForce::Held);
+    }
     let window = window_s();
     sim.set_end_time(SPIN_UP_S + window);
     let mut snaps = Vec::new();

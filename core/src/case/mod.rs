@@ -61,7 +61,8 @@ pub struct Coupling {
     pub drag_law: crate::coupling::DragModel,
     /// DEM steps between recomputations of voidage and drag (1 = every step, the paper's); the
     /// drag on each particle and on the gas is held in between, the gas still steps at its own
-    /// stable step. Default from the run-time/error trade-off (docs/BENCHMARKS.md).
+    /// stable step. Default 20, with the pressure force at the interval's mean, from the
+    /// run-time/error trade-off (docs/BENCHMARKS.md, "Defaults from the front").
     #[serde(default = "d_coupling_interval")]
     pub interval_steps: u32,
     /// Sub-layers of each fluid layer for the voidage the drag law reads (1 = the cell's voidage,
@@ -81,15 +82,15 @@ pub struct Coupling {
     /// cfd/voidage_ramp.rs).
     #[serde(default)]
     pub gas_voidage: GasVoidage,
-    /// The particles' pressure-gradient force −V_p∇p between couplings: "held" (with the drag,
-    /// from the coupling's gas state) or "gas_step" (it follows the gas at each of its steps while
-    /// the drag stays held, so that the phases' pressure forces stay those of one gas state;
-    /// sim/pressure_follow.rs, docs/VALIDATION.md "The pressure force between couplings") or
-    /// "interval_mean" (held, at the mean of the gas's ∇p over its steps of the last interval: the
+    /// The particles' pressure-gradient force −V_p∇p between couplings: "interval_mean" (the
+    /// default: held, at the mean of the gas's ∇p over its steps of the last interval, so the
     /// particles receive the pressure impulse the gas felt, one interval late, at no cost between
-    /// couplings; sim/pressure_mean.rs).
-    /// Not written when it is the default, so the cases of earlier versions keep their keys.
-    #[serde(default, skip_serializing_if = "PressureForce::is_held")]
+    /// couplings; sim/pressure_mean.rs), "held" (the paper's: with the drag, from the coupling's
+    /// gas state) or "gas_step" (it follows the gas at each of its steps while the drag stays
+    /// held; sim/pressure_follow.rs). docs/VALIDATION.md "The pressure force between couplings".
+    /// Always written: a stored case without it is from before "interval_mean" became the
+    /// default and means "held" (`Case::from_stored_json`).
+    #[serde(default)]
     pub pressure_force: PressureForce,
 }
 
@@ -97,16 +98,10 @@ pub struct Coupling {
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum PressureForce {
-    #[default]
     Held,
     GasStep,
+    #[default]
     IntervalMean,
-}
-
-impl PressureForce {
-    fn is_held(&self) -> bool {
-        *self == PressureForce::Held
-    }
 }
 
 /// How the gas's voidage moves between couplings (`coupling.gas_voidage`).
@@ -126,7 +121,7 @@ impl Default for Coupling {
             interval_steps: d_coupling_interval(),
             drag_voidage_sublayers: d_drag_sublayers(),
             gas_voidage: GasVoidage::Held,
-            pressure_force: PressureForce::Held,
+            pressure_force: PressureForce::IntervalMean,
         }
     }
 }
@@ -136,7 +131,7 @@ fn d_drag_sublayers() -> u32 {
 }
 
 fn d_coupling_interval() -> u32 {
-    10
+    20
 }
 
 /// The cylindrical column (tube). Its axis is the z axis, the distributor plate is z = 0.
@@ -524,6 +519,19 @@ impl Case {
     /// Parse JSON (serde errors name the line and column).
     pub fn from_json(s: &str) -> Result<Case, serde_json::Error> {
         serde_json::from_str(s)
+    }
+    /// A case as this program stored it (a checkpoint's, a job's): as `from_json`, except that
+    /// a coupling without `pressure_force` was stored before that key was always written, when
+    /// its absence meant "held", and is read so.
+    pub fn from_stored_json(s: &str) -> Result<Case, serde_json::Error> {
+        let mut v: serde_json::Value = serde_json::from_str(s)?;
+        if let Some(case) = v.as_object_mut() {
+            let coupling = case.entry("coupling").or_insert_with(|| serde_json::json!({}));
+            if let Some(c) = coupling.as_object_mut() {
+                c.entry("pressure_force").or_insert_with(|| "held".into());
+            }
+        }
+        serde_json::from_value(v)
     }
     /// The JSON Schema of a case (published as docs/case.schema.json).
     pub fn json_schema() -> serde_json::Value {

@@ -130,3 +130,24 @@ fn every_shipped_case_parses_without_errors() {
     }
     assert!(seen >= 9, "found {seen} cases");
 }
+
+#[test]
+fn a_stored_case_without_the_pressure_force_means_held_and_a_new_one_the_mean() {
+    // A case a user submits without the key takes today's default.
+    let (fresh, _) = Case::parse_str(paper_case_json()).expect("valid");
+    assert_eq!(fresh.coupling.pressure_force, PressureForce::IntervalMean);
+    assert_eq!(fresh.coupling.interval_steps, 20);
+    // Stored cases always carry it now, and read back as written.
+    let text = serde_json::to_string(&fresh).unwrap();
+    assert!(text.contains(r#""pressure_force":"interval_mean""#), "{text}");
+    assert_eq!(Case::from_stored_json(&text).unwrap(), fresh);
+    // A case stored before (the key left out when it was "held", the default then) reads as held,
+    // with or without a coupling section.
+    let mut old: serde_json::Value = serde_json::from_str(&text).unwrap();
+    old["coupling"].as_object_mut().unwrap().remove("pressure_force");
+    let held = Case::from_stored_json(&old.to_string()).unwrap();
+    assert_eq!(held.coupling.pressure_force, PressureForce::Held);
+    assert_eq!(held.coupling.interval_steps, 20, "the other keys as stored");
+    old.as_object_mut().unwrap().remove("coupling");
+    assert_eq!(Case::from_stored_json(&old.to_string()).unwrap().coupling.pressure_force, PressureForce::Held);
+}

@@ -410,7 +410,7 @@ mod case_as_json {
     }
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Case, D::Error> {
         let text = String::deserialize(d)?;
-        serde_json::from_str(&text).map_err(serde::de::Error::custom)
+        Case::from_stored_json(&text).map_err(serde::de::Error::custom)
     }
 }
 

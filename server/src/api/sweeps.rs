@@ -239,7 +239,7 @@ fn jobs_of(app: &App, record: &SweepRecord) -> anyhow::Result<Vec<Job>> {
 
 /// A finished point's summary from its case and snapshot index.
 fn summary_of(app: &App, job: &Job) -> Option<fluidbed_api::PointSummary> {
-    let case: Case = serde_json::from_str(&app.store.case_json(&job.id).ok()??).ok()?;
+    let case = Case::from_stored_json(&app.store.case_json(&job.id).ok()??).ok()?;
     let infos = app.store.snapshots(&job.id).ok()?;
     Some(summarize(&case, &infos))
 }
