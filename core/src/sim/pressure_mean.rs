@@ -1,12 +1,12 @@
 //! The particles' pressure-gradient force as the mean of the gas's over the last interval (case
-//! `coupling.pressure_force` = "interval_mean"). Held (the default), each particle keeps −V_p∇p of
+//! `coupling.pressure_force` = "interval_mean"). Held (the paper's), each particle keeps −V_p∇p of
 //! the gas state right after a coupling has set the new voidage: the gas holds each cell's mass,
 //! so that state carries the pressure step −pΔε/ε, which the gas relaxes within a few of its
 //! steps while the particles keep it for the whole interval (docs/VALIDATION.md, "The pressure
 //! force between couplings"). Here the coupling gives the particles, in place of that gradient,
 //! the mean of the ∇p the gas's momentum equation used at each of its steps since the last
 //! coupling (`GasSolver::last_step_pressure_gradient`): over a run the particles then receive the
-//! pressure impulse the gas felt, one interval (≈ 12.5 µs) late. Unlike "gas_step"
+//! pressure impulse the gas felt, one interval (25 µs at the default 20) late. Unlike "gas_step"
 //! (pressure_follow.rs) nothing runs per particle between couplings: the cost is a sum over the
 //! bed's cells per gas step.
 
