@@ -54,7 +54,7 @@ fn run_case(end_s: f64) -> (fluidbed_core::case::Case, String) {
     case.outputs.snapshot_interval_s = 0.005;
     case.outputs.fields = vec![Field::Voidage, Field::Pressure];
     case.analysis.from_s = ANALYSIS_FROM_S;
-    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case).expect("case to JSON"));
+    let key = cache_key(&case);
     (case, format!("target/validate-cache/bubbling-44mm-{end_s}s-{key:016x}.bin"))
 }
 

@@ -95,6 +95,9 @@ fn case(u: f64, tube: Tube) -> Case {
     c.outputs.fields = vec![Field::Voidage];
     c.analysis.from_s = FROM_S;
     c.analysis.rise_heights_m = Some(PROBES_M);
+    // The coupling these runs started with (the defaults until 2026-12-06): one set, one coupling.
+    c.coupling.interval_steps = 10;
+    c.coupling.pressure_force = fluidbed_core::case::PressureForce::Held;
     let report = c.validate();
     assert!(report.is_ok(), "slug-rise case invalid: {:?}", report.errors);
     c
@@ -107,8 +110,7 @@ pub fn stewart_davidson(u: f64, umf: f64, d: f64) -> f64 {
 
 /// Where the run at `u` is kept (`.ckpt`: its checkpoint, the last one once it has finished).
 fn cache_path(u: f64, tube: Tube) -> String {
-    let key = fluidbed_core::dem::fnv1a(&serde_json::to_string(&case(u, tube)).expect("case to JSON"));
-    format!("target/validate-cache/slug-rise-U{u}-{key:016x}.bin")
+    format!("target/validate-cache/slug-rise-U{u}-{:016x}.bin", cache_key(&case(u, tube)))
 }
 
 /// The finished run at `u` in `tube`, if it has finished (never starts it).
@@ -221,10 +223,25 @@ pub fn run() -> serde_json::Value {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn the_formula_gives_the_published_values() {
         // 0.35 √(g D) for D = 50 mm is 0.245 m/s (the paper's tube).
         let v = super::stewart_davidson(0.3, 0.3, 0.05);
         assert!((v - 0.2451).abs() < 1e-3, "{v}");
+    }
+
+    #[test]
+    fn the_runs_made_before_keep_their_cache_keys() {
+        // The 50-mm run at 0.54 m/s and the finished 44-mm runs that pressure-oscillation reads.
+        for (u, tube, key) in [
+            (0.54, PAPER_TUBE, "ff69819feec9ea01"),
+            (0.54, BUBBLING_TUBE, "bb25fcd642c143a0"),
+            (0.6, BUBBLING_TUBE, "a43e74c38422ada0"),
+        ] {
+            let path = cache_path(u, tube);
+            assert!(path.ends_with(&format!("{key}.bin")), "U = {u}, {} mm: {path}", tube.mm);
+        }
     }
 }
