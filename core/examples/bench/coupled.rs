@@ -14,8 +14,6 @@ use std::time::Instant;
 pub const FLUIDIZED_AT_S: f64 = 0.3;
 const STEPS: u64 = 2000;
 const ROUND: u64 = 250;
-/// The coupling interval of the extra mode (with the gas's voidage extrapolated).
-const LONG_INTERVAL: u32 = 20;
 
 fn cache_dir() -> PathBuf {
     let d =
@@ -142,78 +140,70 @@ fn add(a: &mut StageTimers, b: &StageTimers) {
     a.output += b.output;
 }
 
+/// A mode of `run` beside the defaults: its name and what it changes on the restored state.
+type Setting = (&'static str, fn(&mut Simulation));
+
 pub fn run() {
+    use fluidbed_core::case::{GasVoidage, PressureForce};
     // FLUIDBED_BENCH_CASE names another file of cases/ to time the same way.
     let name = std::env::var("FLUIDBED_BENCH_CASE").unwrap_or_else(|_| "bubbling-44mm.json".into());
     let case = shipped_case(&name);
     let state = state_at(&case, FLUIDIZED_AT_S, name.trim_end_matches(".json"));
     let restore = || Simulation::restore(&state).expect("cached state");
-    let (mut alone, mut default, mut paper, mut long) = (restore(), restore(), restore(), restore());
+    let (mut alone, mut default, mut paper) = (restore(), restore(), restore());
     // The paper's coupling: every step, the pressure force of the moment.
     paper.set_coupling_interval(1);
-    paper.set_pressure_force(fluidbed_core::case::PressureForce::Held);
-    // A longer interval with the gas's voidage extrapolated (docs/BENCHMARKS.md, "Run time
-    // against error"): reported beside the others, not a default.
-    long.set_coupling_interval(LONG_INTERVAL);
-    long.set_gas_voidage(fluidbed_core::case::GasVoidage::Extrapolated);
-    // The particles' pressure force following the gas (docs/VALIDATION.md, "The pressure force
-    // between couplings") at intervals of 10 and 20: not defaults.
-    let (mut follow, mut follow_long) = (restore(), restore());
-    follow.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
-    follow.set_coupling_interval(10);
-    follow_long.set_pressure_force(fluidbed_core::case::PressureForce::GasStep);
-    follow_long.set_coupling_interval(LONG_INTERVAL);
-    // Held at the mean of the gas's gradient over the last interval (sim/pressure_mean.rs).
-    // The defaults before 2026-12-06: held at an interval of 10; and the mean at 10.
-    let (mut mean, mut held_10) = (restore(), restore());
-    mean.set_pressure_force(fluidbed_core::case::PressureForce::IntervalMean);
-    mean.set_coupling_interval(10);
-    held_10.set_pressure_force(fluidbed_core::case::PressureForce::Held);
-    held_10.set_coupling_interval(10);
-    let (mut tm, mut th10) = (Tally::default(), Tally::default());
-    // The gas stepped by the paper's AB3 (the default is forward–backward) at the default interval.
-    let mut ab3 = restore();
-    ab3.set_gas_time_scheme(fluidbed_core::cfd::TimeScheme::Ab3);
-    let mut tab3 = Tally::default();
-    let (mut ta, mut td, mut tp, mut tl) = (Tally::default(), Tally::default(), Tally::default(), Tally::default());
-    let (mut tf, mut tfl) = (Tally::default(), Tally::default());
-    // The extra modes are reported beside the defaults; one the watchdog stops is named with why.
-    let mut stopped: [Option<String>; 6] = Default::default();
+    paper.set_pressure_force(PressureForce::Held);
+    // Other settings, reported beside the defaults (not defaults; docs/BENCHMARKS.md and
+    // docs/VALIDATION.md "The pressure force between couplings"); one the watchdog stops is named
+    // with why.
+    let settings: [Setting; 6] = [
+        ("extrapolated_interval_20", |s| {
+            s.set_coupling_interval(20);
+            s.set_gas_voidage(GasVoidage::Extrapolated);
+        }),
+        ("pressure_force_gas_step_interval_10", |s| {
+            s.set_coupling_interval(10);
+            s.set_pressure_force(PressureForce::GasStep);
+        }),
+        ("pressure_force_gas_step_interval_20", |s| {
+            s.set_coupling_interval(20);
+            s.set_pressure_force(PressureForce::GasStep);
+        }),
+        ("pressure_force_interval_mean_interval_10", |s| {
+            s.set_coupling_interval(10);
+            s.set_pressure_force(PressureForce::IntervalMean);
+        }),
+        // The gas stepped by the paper's AB3 (the default is forward–backward).
+        ("gas_ab3", |s| s.set_gas_time_scheme(fluidbed_core::cfd::TimeScheme::Ab3)),
+        // The defaults before 2026-12-06.
+        ("held_interval_10", |s| {
+            s.set_coupling_interval(10);
+            s.set_pressure_force(PressureForce::Held);
+        }),
+    ];
+    let mut extra: Vec<(&str, Simulation, Tally, Option<String>)> = settings
+        .into_iter()
+        .map(|(name, set)| {
+            let mut sim = restore();
+            set(&mut sim);
+            (name, sim, Tally::default(), None)
+        })
+        .collect();
+    let (mut ta, mut td, mut tp) = (Tally::default(), Tally::default(), Tally::default());
     for _ in 0..STEPS / ROUND {
         dem_round(&mut alone, ROUND, &mut ta);
         coupled_round(&mut default, ROUND, &mut td);
         coupled_round(&mut paper, ROUND, &mut tp);
-        let extra = [
-            (&mut long, &mut tl),
-            (&mut follow, &mut tf),
-            (&mut follow_long, &mut tfl),
-            (&mut mean, &mut tm),
-            (&mut ab3, &mut tab3),
-            (&mut held_10, &mut th10),
-        ];
-        for ((sim, t), stop) in extra.into_iter().zip(stopped.iter_mut()) {
-            if stop.is_none() {
-                *stop = try_coupled_round(sim, ROUND, t).err();
-            }
+        for (_, sim, t, stop) in extra.iter_mut().filter(|e| e.3.is_none()) {
+            *stop = try_coupled_round(sim, ROUND, t).err();
         }
     }
     let dt = case.dem.time_step_s;
     let plan = default.plan();
     let share = |t: &Tally| 1.0 - ta.per_step() / t.per_step();
-    let long_name = format!("extrapolated_interval_{LONG_INTERVAL}");
-    let follow_long_name = format!("pressure_force_gas_step_interval_{LONG_INTERVAL}");
-    let none = None;
-    let modes = [
-        ("dem_alone", &ta, &none),
-        ("default", &td, &none),
-        ("paper", &tp, &none),
-        (long_name.as_str(), &tl, &stopped[0]),
-        ("pressure_force_gas_step_interval_10", &tf, &stopped[1]),
-        (follow_long_name.as_str(), &tfl, &stopped[2]),
-        ("pressure_force_interval_mean_interval_10", &tm, &stopped[3]),
-        ("gas_ab3", &tab3, &stopped[4]),
-        ("held_interval_10", &th10, &stopped[5]),
-    ];
+    let main = [("dem_alone", &ta), ("default", &td), ("paper", &tp)].map(|(n, t)| (n, t, None));
+    let modes = main.iter().map(|(n, t, s)| (*n, *t, s)).chain(extra.iter().map(|(n, _, t, s)| (*n, t, s)));
     for (name, t, stop) in modes {
         println!(
             "{}",

@@ -6,7 +6,6 @@ use fluidbed_core::sim::{Simulation, Snapshot};
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// A case from the project's cases/ folder.
 /// The key a long run is kept under in target/validate-cache: the case's JSON as it was written
 /// before `coupling.pressure_force` was always written (left out when "held"), so the runs made
 /// before keep their keys.
@@ -15,6 +14,7 @@ pub fn cache_key(case: &Case) -> u64 {
     fluidbed_core::dem::fnv1a(&json.replace(r#","pressure_force":"held""#, ""))
 }
 
+/// A case from the project's cases/ folder.
 pub fn load_case(file: &str) -> Case {
     load_case_path(&format!("{}/../cases/{file}", env!("CARGO_MANIFEST_DIR")))
 }

@@ -51,14 +51,9 @@ pub(super) fn add_sublayer_pressure(
         let k = s / per;
         let (lo, hi) = (k.saturating_sub(1), (k + 1).min(layers - 1));
         let mut sum = [0.0; 3];
-        for k2 in lo..=hi {
-            let at = s - k * per + k2 * per;
-            if at < used {
-                for row in d.sums {
-                    for q in 0..3 {
-                        sum[q] += row[at][q];
-                    }
-                }
+        for at in (lo..=hi).map(|k2| s - k * per + k2 * per).filter(|&at| at < used) {
+            for row in d.sums {
+                (0..3).for_each(|q| sum[q] += row[at][q]);
             }
         }
         let w = 1.0 / ((hi - lo + 1) as f64 * d.v_sub * clamp_voidage(d.voidage[s], d.eps_min));

@@ -93,8 +93,15 @@ impl SplitConstants {
     }
 }
 
+/// The branch-free split of a cube side along one axis into a fixed number of (cell, share)
+/// pairs (`interval_split`'s shares, without its loop).
+pub trait FixedSplit: Copy {
+    type Pairs: AsRef<[(usize, f64)]>;
+    fn split(&self, c: f64) -> Self::Pairs;
+}
+
 /// `interval_split` when h ≤ the cell width: the interval lies in at most two cells, given as
-/// two (cell, share) pairs (the second share 0 when it fits in one cell), without branches.
+/// two (cell, share) pairs (the second share 0 when it fits in one cell).
 #[derive(Clone, Copy, Debug)]
 pub struct SplitTwo(SplitConstants);
 
@@ -102,17 +109,21 @@ impl SplitTwo {
     pub fn new(axis: &Axis, h: f64) -> SplitTwo {
         SplitTwo(SplitConstants::new(axis, h, 1.0, "split_two"))
     }
+}
+
+impl FixedSplit for SplitTwo {
+    type Pairs = [(usize, f64); 2];
     /// Cell i holds the first share, i + 1 the rest. In the last cell both pairs name that
     /// cell, so it holds all of it (it reaches to +∞).
     #[inline(always)]
-    pub fn split(&self, c: f64) -> [(usize, f64); 2] {
+    fn split(&self, c: f64) -> Self::Pairs {
         let (i, share) = self.0.first(c);
         [(i, share), ((i + 1).min(self.0.n - 1), 1.0 - share)]
     }
 }
 
 /// `interval_split` when dl < h ≤ 2·dl (a cube side across thin layers): at most three cells,
-/// given as three (cell, share) pairs, without branches.
+/// given as three (cell, share) pairs.
 #[derive(Clone, Copy, Debug)]
 pub struct SplitThree(SplitConstants);
 
@@ -120,37 +131,19 @@ impl SplitThree {
     pub fn new(axis: &Axis, h: f64) -> SplitThree {
         SplitThree(SplitConstants::new(axis, h, 2.0, "split_three"))
     }
+}
+
+impl FixedSplit for SplitThree {
+    type Pairs = [(usize, f64); 3];
     /// The first share in cell i, at most a whole cell's dl/h of what is left in i + 1, the rest
     /// in i + 2; cells past the last name the last.
     #[inline(always)]
-    pub fn split(&self, c: f64) -> [(usize, f64); 3] {
+    fn split(&self, c: f64) -> Self::Pairs {
         let (i, first) = self.0.first(c);
         let second = self.0.dl_over_h.min(1.0 - first);
         let third = (1.0 - first - second).max(0.0);
         let top = self.0.n - 1;
         [(i, first), ((i + 1).min(top), second), ((i + 2).min(top), third)]
-    }
-}
-
-/// The split of a cube side along one axis into a fixed number of (cell, share) pairs.
-pub trait FixedSplit: Copy {
-    type Pairs: AsRef<[(usize, f64)]>;
-    fn pairs(&self, c: f64) -> Self::Pairs;
-}
-
-impl FixedSplit for SplitTwo {
-    type Pairs = [(usize, f64); 2];
-    #[inline(always)]
-    fn pairs(&self, c: f64) -> Self::Pairs {
-        self.split(c)
-    }
-}
-
-impl FixedSplit for SplitThree {
-    type Pairs = [(usize, f64); 3];
-    #[inline(always)]
-    fn pairs(&self, c: f64) -> Self::Pairs {
-        self.split(c)
     }
 }
 

@@ -207,7 +207,7 @@ fn deposit_small_cubes<Z: FixedSplit>(
 ) {
     for p in positions {
         let ([(x0, wx0), (x1, wx1)], [(y0, wy0), (y1, wy1)]) = (across.split(p[0]), across.split(p[1]));
-        for &(k, wz) in up.pairs(p[2]).as_ref() {
+        for &(k, wz) in up.split(p[2]).as_ref() {
             let wz = vp * wz;
             for (by, w) in [(y0, wz * wy0), (y1, wz * wy1)] {
                 let row = (k * nb + by) * nb - base;
