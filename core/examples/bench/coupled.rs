@@ -190,6 +190,17 @@ pub fn run() {
             (name, sim, Tally::default(), None)
         })
         .collect();
+    // The gas's pressure waves at half the sound speed (`gas.acoustic_speed_factor`), the defaults
+    // otherwise: its own fluidized state, since the equation of state differs.
+    let mut half = case.clone();
+    half.gas.as_mut().expect("gas").acoustic_speed_factor = 0.5;
+    let half_state = state_at(&half, FLUIDIZED_AT_S, &format!("{}-acoustic-0.5", name.trim_end_matches(".json")));
+    extra.push((
+        "acoustic_speed_half",
+        Simulation::restore(&half_state).expect("cached state"),
+        Tally::default(),
+        None,
+    ));
     let (mut ta, mut td, mut tp) = (Tally::default(), Tally::default(), Tally::default());
     for _ in 0..STEPS / ROUND {
         dem_round(&mut alone, ROUND, &mut ta);
