@@ -3,7 +3,9 @@
 //! of: the case's default coupling, the paper's every-step coupling (interval 1, the gas at its
 //! own stable step as in both), and the same particles stepped by the DEM alone (gas off). The
 //! three run interleaved in one process (rounds of 250 steps), so their ratio is not at the mercy
-//! of the VM's speed swings. gas_coupling_share = 1 − DEM-alone step / coupled step.
+//! of the VM's speed swings. gas_coupling_share = 1 − DEM-alone step / coupled step. Other
+//! settings run interleaved beside them as extra modes (`coupled_mode` lines): from the same
+//! state, except the gas at half the sound speed, which needs a fluidized state of its own.
 
 use fluidbed_core::case::Case;
 use fluidbed_core::sim::{Simulation, StageTimers};
