@@ -13,7 +13,7 @@
 //!    spin-up) alone, `gas-voidage` the reference and the gas's voidage extrapolated,
 //!    interpolated and held between couplings at intervals 10, 20, 50 alone, `scheme` the gas's
 //!    time schemes, `pressure` the particles' pressure force held or at the interval's mean at
-//!    intervals 10 and 20.
+//!    intervals 10 and 20, `interval` the interval's mean at intervals 20, 30, 40 and 50.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -289,6 +289,26 @@ fn pressure_front() {
     }
 }
 
+/// `-- tradeoff interval`: the pressure force at the interval's mean (the default) at coupling
+/// intervals 20, 30, 40 and 50, against the reference beside its floor.
+fn interval_front() {
+    use fluidbed_core::case::PressureForce;
+    let reference = bed(1);
+    let r = reference_beside_floor(&reference, &bed(2));
+    for interval in [20, 30, 40, 50] {
+        point_from_spin_up(
+            &reference,
+            &r,
+            "coupling_interval",
+            format!("IntervalMean at interval {interval}"),
+            |sim| {
+                sim.set_coupling_interval(interval);
+                sim.set_pressure_force(PressureForce::IntervalMean);
+            },
+        );
+    }
+}
+
 /// `-- tradeoff sound`: the reference window and the acoustic speed points alone.
 fn acoustic_front() {
     let reference = bed(1);
@@ -452,6 +472,10 @@ pub fn run() {
     }
     if part == "pressure" {
         pressure_front();
+        return;
+    }
+    if part == "interval" {
+        interval_front();
         return;
     }
     if part.is_empty() || part == "cost" {
