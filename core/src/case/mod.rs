@@ -62,7 +62,9 @@ pub struct Coupling {
     /// DEM steps between recomputations of voidage and drag (1 = every step, the paper's); the
     /// drag on each particle and on the gas is held in between, the gas still steps at its own
     /// stable step. Default 20, with the pressure force at the interval's mean, from the
-    /// run-time/error trade-off (docs/BENCHMARKS.md, "Defaults from the front").
+    /// run-time/error trade-off (docs/BENCHMARKS.md, "Defaults from the front"); drag held longer
+    /// than 25 µs (interval × DEM step) warns: longer holds made the coupling oscillate
+    /// (docs/BENCHMARKS.md, "Longer intervals").
     #[serde(default = "d_coupling_interval")]
     pub interval_steps: u32,
     /// Sub-layers of each fluid layer for the voidage the drag law reads (1 = the cell's voidage,

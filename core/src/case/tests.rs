@@ -151,3 +151,28 @@ fn a_stored_case_without_the_pressure_force_means_held_and_a_new_one_the_mean() 
     old.as_object_mut().unwrap().remove("coupling");
     assert_eq!(Case::from_stored_json(&old.to_string()).unwrap().coupling.pressure_force, PressureForce::Held);
 }
+
+#[test]
+fn a_drag_held_longer_than_tested_warns_and_the_default_does_not() {
+    let gas = |n: u32| {
+        let mut c = Case::parse_str(paper_case_json()).expect("valid").0;
+        c.gas = Some(Default::default());
+        c.coupling.interval_steps = n;
+        c
+    };
+    let warned = |c: &Case| c.validate().warnings.iter().any(|w| w.path == "/coupling/interval_steps");
+    // The default: 20 steps of 1.25 µs, 25 µs of held drag.
+    assert!(!warned(&gas(d_coupling_interval())));
+    let rep = gas(30).validate();
+    assert!(rep.is_ok(), "a warning only: {:?}", rep.errors);
+    let w = rep.warnings.iter().find(|w| w.path == "/coupling/interval_steps").expect("warned");
+    assert!(w.allowed.contains("<= 20"), "{}", w.allowed);
+    // A finer DEM step holds the drag for less time at the same count.
+    let mut fine = gas(30);
+    fine.dem.time_step_s = 0.625e-6;
+    assert!(!warned(&fine));
+    // No gas, or a frozen bed, holds no drag on moving particles.
+    let mut frozen = gas(30);
+    frozen.dem.frozen = true;
+    assert!(!warned(&frozen));
+}
