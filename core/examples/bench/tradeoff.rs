@@ -23,7 +23,7 @@
 
 use crate::coupled::{coupled_round, shipped_case, state_at, Tally};
 use crate::voidage::packing;
-use fluidbed_core::case::{BoxSplit, Case, GasVoidage, Voidage};
+use fluidbed_core::case::{BoxSplit, Case, GasVoidage, PressureForce, Voidage};
 use fluidbed_core::cfd::TimeScheme;
 use fluidbed_core::coupling::build_voidage;
 use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
@@ -150,7 +150,7 @@ fn window_as(case: &Case, label: &str, interval: u32, how: GasVoidage) -> (Vec<S
     sim.set_gas_voidage(how);
     if interval == 1 {
         // The reference is the paper's coupling: every step, the pressure force of the moment.
-        sim.set_pressure_force(fluidbed_core::case::PressureForce::Held);
+        sim.set_pressure_force(PressureForce::Held);
     }
     let window = window_s();
     sim.set_end_time(SPIN_UP_S + window);
@@ -276,36 +276,27 @@ fn scheme_front() {
 /// the interval's mean (`coupling.pressure_force`), at intervals 10 and 20, each from the
 /// reference's spin-up state, against the reference and beside the noise floor.
 fn pressure_front() {
-    use fluidbed_core::case::PressureForce;
-    let reference = bed(1);
-    let r = reference_beside_floor(&reference, &bed(2));
-    for interval in [10, 20] {
-        for how in [PressureForce::Held, PressureForce::IntervalMean] {
-            point_from_spin_up(&reference, &r, "pressure_force", format!("{how:?} at interval {interval}"), |sim| {
-                sim.set_coupling_interval(interval);
-                sim.set_pressure_force(how);
-            });
-        }
-    }
+    pressure_force_points("pressure_force", &[10, 20], &[PressureForce::Held, PressureForce::IntervalMean]);
 }
 
 /// `-- tradeoff interval`: the pressure force at the interval's mean (the default) at coupling
 /// intervals 20, 30, 40 and 50, against the reference beside its floor.
 fn interval_front() {
-    use fluidbed_core::case::PressureForce;
+    pressure_force_points("coupling_interval", &[20, 30, 40, 50], &[PressureForce::IntervalMean]);
+}
+
+/// Each pressure force of `hows` at each coupling interval of `intervals`, one window each from
+/// the reference's spin-up, printed as points of `knob` beside the reference's floor.
+fn pressure_force_points(knob: &str, intervals: &[u32], hows: &[PressureForce]) {
     let reference = bed(1);
     let r = reference_beside_floor(&reference, &bed(2));
-    for interval in [20, 30, 40, 50] {
-        point_from_spin_up(
-            &reference,
-            &r,
-            "coupling_interval",
-            format!("IntervalMean at interval {interval}"),
-            |sim| {
+    for &interval in intervals {
+        for &how in hows {
+            point_from_spin_up(&reference, &r, knob, format!("{how:?} at interval {interval}"), |sim| {
                 sim.set_coupling_interval(interval);
-                sim.set_pressure_force(PressureForce::IntervalMean);
-            },
-        );
+                sim.set_pressure_force(how);
+            });
+        }
     }
 }
 
