@@ -3,6 +3,7 @@
 
 mod adaptive;
 mod cfd;
+mod checkpoint;
 mod coupled;
 mod dem;
 mod dp_probe;
@@ -27,6 +28,7 @@ fn run(what: &str) {
         "cfd" => cfd::run(),
         "coupled" => coupled::run(),
         "coupled-parts" => coupled::parts(),
+        "checkpoint" => checkpoint::run(),
         "gas-context" => coupled::gas_context(),
         "gas-team" => coupled::gas_team(),
         "coupled-micro" => coupled::micro(),

@@ -20,6 +20,7 @@
 use super::drag::beetstra_f;
 use super::drag::{clamp_voidage, drag_force, Beetstra, DiFelice, DragLaw, DragModel, Gidaspow};
 use super::sublayer_pressure::{add_sublayer_pressure, SubLayerDrag};
+use crate::dem::buffers::resize_reused;
 use crate::grid::CylGrid;
 use crate::simd::per_isa;
 use rayon::prelude::*;
@@ -135,7 +136,8 @@ pub struct Exchange {
     frozen: Vec<(f64, f64, f64)>,
     /// Per-cell tables of the three laws (only the case's law is filled), refreshed each call.
     tables: Tables,
-    /// Drag on the gas per chunk and cell (cell basis), summed into the caller's output.
+    /// Drag on the gas per chunk and cell (cell basis) of the layers that hold particles, summed
+    /// into the caller's output.
     chunk_force: Vec<Vec<[f64; 3]>>,
     /// Sub-layers: the pressure correction the gas loses per sub-cell, and scratch (sublayer_pressure.rs).
     sub_lost: Vec<[f64; 3]>,
@@ -170,7 +172,7 @@ impl Exchange {
             cell_of: vec![0; particles],
             frozen: Vec::new(),
             tables: Tables::default(),
-            chunk_force: vec![vec![[0.0; 3]; grid.num_cells()]; CHUNKS],
+            chunk_force: vec![Vec::new(); CHUNKS],
             sub_lost: Vec::new(),
             sub_scratch: Vec::new(),
             sub_count: Vec::new(),
@@ -236,7 +238,7 @@ impl Exchange {
         let used = gas.layers.min(grid.nz) * m * per;
         // 1. per drag cell (parallel): everything that does not depend on the particle
         let (mu, d) = (par.mu, par.d);
-        table.resize(drag_cells, CellTable::default());
+        resize_reused(table, used, CellTable::default());
         let basis = &self.cell_basis;
         table[..used].par_iter_mut().with_min_len(256).enumerate().for_each(|(s, t)| {
             let c = fluid_cell(s, per, m);
@@ -264,19 +266,19 @@ impl Exchange {
         let chunk = pos.len().div_ceil(CHUNKS).max(1);
         // A particle above the used layers would index past this slice: a panic, never a stale table.
         let table = &table[..used];
-        let (dgrid, cells_d) = (drag.grid, drag_cells);
-        self.chunk_force.resize_with(CHUNKS, || vec![[0.0; 3]; cells_d]);
-        // Rows of chunks without particles add nothing.
+        let dgrid = drag.grid;
+        // The chunks' sums over the used cells; rows of chunks without particles add nothing.
+        self.chunk_force.resize_with(CHUNKS, Vec::new);
         for row in &mut self.chunk_force[pos.len().div_ceil(chunk)..] {
-            row.clear();
-            row.resize(cells_d, [0.0; 3]);
+            resize_reused(row, used, [0.0; 3]);
+            row.fill([0.0; 3]);
         }
         (self.chunk_force.par_iter_mut(), force_out.par_chunks_mut(chunk), self.cell_of.par_chunks_mut(chunk))
             .into_par_iter()
             .enumerate()
             .for_each(|(n, (sum, f, co))| {
-                sum.resize(cells_d, [0.0; 3]);
-                sum[..used].fill([0.0; 3]);
+                resize_reused(sum, used, [0.0; 3]);
+                sum.fill([0.0; 3]);
                 let lo = n * chunk;
                 particle_block_pass_on::<L>(
                     dgrid,

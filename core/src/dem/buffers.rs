@@ -1,7 +1,8 @@
-//! Resizing the DEM's reused per-particle and per-entry buffers (chunk force rows, near list,
-//! selection codes). `Vec::resize` past the capacity doubles it and copies the old contents,
-//! so a buffer a few rows longer than last time held two, then four copies' worth of memory;
-//! here a buffer that must grow is freed first and replaced by one 1/16 longer than asked.
+//! Resizing reused per-particle, per-entry and per-cell buffers (the DEM's chunk force rows,
+//! near list and selection codes; the exchange's per-cell tables and sums). `Vec::resize` past
+//! the capacity doubles it and copies the old contents, so a buffer a few rows longer than last
+//! time held two, then four copies' worth of memory; here a buffer that must grow is freed first
+//! and replaced by one 1/16 longer than asked.
 
 /// `v` resized to `len` (new elements `fill`); the old contents are kept only when it fits.
 pub(crate) fn resize_reused<T: Clone>(v: &mut Vec<T>, len: usize, fill: T) {

@@ -26,7 +26,7 @@
 mod ab_update;
 mod batch;
 mod bed;
-mod buffers;
+pub(crate) mod buffers;
 mod contact;
 mod contact_styles;
 mod diagnostics;

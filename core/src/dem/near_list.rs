@@ -47,6 +47,12 @@ impl<'de> serde::Deserialize<'de> for Retired {
     }
 }
 
+/// A selection code: the list entry is left out, kept (with the list's history, if any), or
+/// kept with the history of the old near entry of the same partner.
+const SKIP: u8 = 0;
+const TAKE: u8 = 1;
+const TAKE_OLD: u8 = 2;
+
 /// Where the contact histories of a selection come from.
 #[derive(Clone, Copy)]
 pub enum Histories<'a> {
@@ -67,10 +73,11 @@ impl NearList {
     }
 
     /// `select` into this list's storage (its old contents are dropped; reusing the memory
-    /// spares the page faults of fresh allocations). `code` is scratch, one word per entry of
-    /// `outer`: 0 left out, 1 kept with `outer`'s history (none, under `Histories::Near`),
-    /// p + 2 kept with the old near entry p's. Two parallel sweeps: codes and row counts, then
-    /// the rows copied into place.
+    /// spares the page faults of fresh allocations). `code` is scratch, one byte per entry of
+    /// `outer`: `SKIP`, `TAKE` (with `outer`'s history; none under `Histories::Near`) or
+    /// `TAKE_OLD` (with the history of the old near entry of the same partner, found again in
+    /// sweep 2 by walking the old row beside the list row). Two parallel sweeps: codes and row
+    /// counts, then the rows copied into place.
     pub fn select_into(
         &mut self,
         outer: &NeighborList,
@@ -78,7 +85,7 @@ impl NearList {
         diameter: f64,
         gap: f64,
         hist: Histories,
-        code: &mut Vec<u32>,
+        code: &mut Vec<u8>,
     ) {
         let n = outer.offsets.len().saturating_sub(1);
         let total_in = outer.nbr.len();
@@ -88,7 +95,6 @@ impl NearList {
         let old = match hist {
             Histories::Near(old) => {
                 assert!(old.list.offsets.len() == n + 1, "near list of another list");
-                assert!(old.list.nbr.len() <= u32::MAX as usize - 2, "list too long");
                 old
             }
             Histories::Outer => {
@@ -125,8 +131,8 @@ impl NearList {
                     let xj = x[outer.nbr[k] as usize];
                     let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                     let take = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach2 || live;
-                    let c = if matched { p as u32 + 2 } else { 1 };
-                    codes[k - base] = if take { c } else { 0 };
+                    let c = if matched { TAKE_OLD } else { TAKE };
+                    codes[k - base] = if take { c } else { SKIP };
                     cnt[i - r.start] += take as u32;
                     p += matched as usize;
                 }
@@ -153,23 +159,29 @@ impl NearList {
             let (h0, h1) = std::mem::take(&mut h).split_at_mut(len);
             let (t0, t1) = std::mem::take(&mut t).split_at_mut(len);
             (j, h, t) = (j1, h1, t1);
-            work.push((entries(&r), j0, h0, t0));
+            work.push((r, j0, h0, t0));
         }
         let code = &code[..];
-        work.into_par_iter().for_each(|(ks, nbr, shear, touch)| {
+        work.into_par_iter().for_each(|(rows, nbr, shear, touch)| {
             let mut e = 0;
-            for k in ks {
-                let c = code[k] as usize;
-                if c == 0 {
-                    continue;
+            for i in rows {
+                // Cursor over the old near row i, as in sweep 1.
+                let (mut p, p_end) =
+                    if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
+                let row = outer.offsets[i] as usize..outer.offsets[i + 1] as usize;
+                for (k, &c) in row.clone().zip(&code[row]) {
+                    let matched = p < p_end && old.list.nbr[p] == outer.nbr[k];
+                    if c != SKIP {
+                        let (sh, to) = match (c, from_old) {
+                            (TAKE, false) => (outer.shear[k], outer.touch[k]),
+                            (TAKE, true) => ([0.0; 3], 0),
+                            _ => (old.list.shear[p], old.list.touch[p]),
+                        };
+                        (nbr[e], shear[e], touch[e]) = (outer.nbr[k], sh, to);
+                        e += 1;
+                    }
+                    p += matched as usize;
                 }
-                let (sh, to) = match (c, from_old) {
-                    (1, false) => (outer.shear[k], outer.touch[k]),
-                    (1, true) => ([0.0; 3], 0),
-                    _ => (old.list.shear[c - 2], old.list.touch[c - 2]),
-                };
-                (nbr[e], shear[e], touch[e]) = (outer.nbr[k], sh, to);
-                e += 1;
             }
         });
     }

@@ -56,7 +56,7 @@ pub struct DemSystem {
     pub(super) last_move: f64,
     /// Storage reused by near-list refreshes (the previous list's, and a code per entry).
     #[serde(skip)]
-    pub(super) spare: (NearList, Vec<u32>),
+    pub(super) spare: (NearList, Vec<u8>),
     #[serde(skip)]
     pub(super) sc_threads: usize,
     /// Wall time of near-list refreshes and Verlet-list rebuilds (timers).
