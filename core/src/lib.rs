@@ -3,6 +3,7 @@
 //! case JSON -> `Case` -> `Simulation` -> `Snapshot`s.
 
 pub mod analysis;
+mod buffers;
 pub mod case;
 pub mod cfd;
 pub mod coupling;

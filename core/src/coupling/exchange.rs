@@ -20,7 +20,7 @@
 use super::drag::beetstra_f;
 use super::drag::{clamp_voidage, drag_force, Beetstra, DiFelice, DragLaw, DragModel, Gidaspow};
 use super::sublayer_pressure::{add_sublayer_pressure, SubLayerDrag};
-use crate::dem::buffers::resize_reused;
+use crate::buffers::resize_reused;
 use crate::grid::CylGrid;
 use crate::simd::per_isa;
 use rayon::prelude::*;

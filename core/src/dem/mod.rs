@@ -26,7 +26,6 @@
 mod ab_update;
 mod batch;
 mod bed;
-pub(crate) mod buffers;
 mod contact;
 mod contact_styles;
 mod diagnostics;

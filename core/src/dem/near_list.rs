@@ -13,9 +13,9 @@
 //! forces bit for bit (the chunk split follows the entry counts, so with several chunks the force
 //! sums may group differently and differ in rounding).
 
-use super::buffers::resize_reused;
 use super::contact::V3;
 use super::neighbors::NeighborList;
+use crate::buffers::resize_reused;
 use rayon::prelude::*;
 
 /// Rows per work block of a refresh (fixed, so results do not depend on the thread count).

@@ -2,9 +2,9 @@
 //! each with a private force buffer, planned once per neighbour-list build. A checkpoint carries
 //! the plan's cuts, so that a restored run sums its pair forces in the same order.
 
-use super::buffers::resize_reused;
 use super::neighbors::NeighborList;
 use super::pair_scatter::PairSum;
+use crate::buffers::resize_reused;
 use rayon::prelude::*;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
