@@ -108,7 +108,11 @@ pub fn try_coupled_round(sim: &mut Simulation, steps: u64, t: &mut Tally) -> Res
     while left > 0 {
         let before = sim.steps();
         sim.advance(left).map_err(|e| e.to_string())?;
-        left -= sim.steps() - before;
+        let taken = sim.steps() - before;
+        if taken == 0 && sim.time() >= sim.end_time() {
+            return Err(format!("the run is at its end time ({} s)", sim.end_time()));
+        }
+        left -= taken;
     }
     t.wall += t0.elapsed().as_secs_f64();
     t.steps += steps;
