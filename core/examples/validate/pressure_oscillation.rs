@@ -3,8 +3,8 @@
 //! to erupt at the top of the bed"). The paper's bed (50 mm, 110 mm settled, ≈ 150k particles for
 //! several seconds) does not fit a session on 2 cores, so this reads beds that do:
 //! - the 44-mm bubbling bed at 0.6 m/s (the run of `bubbling`, 2 simulated s);
-//! - the 44-mm, 160-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
-//!   paper's 0.563 m/s),
+//! - the 160-mm slugging beds of `slug-rise` at 0.54 and 0.60 m/s (1.8 and 2 U_mf, beside the
+//!   paper's 0.563 m/s), in the paper's 50-mm tube and in the 44-mm one,
 //!
 //! each where its run has finished: this never starts them (each is an hour or more).
 //!
@@ -54,21 +54,36 @@ pub fn run() -> Value {
         }
     };
     println!("{bubbling}");
-    let mut slugging = Vec::new();
-    for u in [0.54, 0.60] {
-        match crate::slug_rise::finished_at(u, crate::slug_rise::BUBBLING_TUBE) {
-            Some(done) => {
-                let p = point(
-                    &format!("44-mm bed, 160 mm settled, U = {u} m/s"),
-                    &done.analysis,
-                    &format!("docs/img/pressure_oscillation_slug44_U{u}.png"),
-                );
-                println!("{p}");
-                slugging.push(p);
+    // The paper's 50-mm tube first (its Fig. 9 bed is 50 mm wide), then the 44-mm one; the figure
+    // is the paper tube's where one of its runs has finished.
+    let mut by_tube = Vec::new();
+    for tube in [crate::slug_rise::PAPER_TUBE, crate::slug_rise::BUBBLING_TUBE] {
+        let mut points = Vec::new();
+        for u in [0.54, 0.60] {
+            match crate::slug_rise::finished_at(u, tube) {
+                Some(done) => {
+                    let p = point(
+                        &format!("{}-mm bed, 160 mm settled, U = {u} m/s", tube.mm),
+                        &done.analysis,
+                        &format!("docs/img/pressure_oscillation_slug{}_U{u}.png", tube.mm),
+                    );
+                    println!("{p}");
+                    points.push(p);
+                }
+                None => eprintln!(
+                    "[pressure-oscillation] the {}-mm slug-rise run at U = {u} m/s has not finished; not read",
+                    tube.mm
+                ),
             }
-            None => eprintln!("[pressure-oscillation] the slug-rise run at U = {u} m/s has not finished; not read"),
         }
+        by_tube.push((tube.mm, points));
     }
+    let (tube_mm, slugging) =
+        by_tube.into_iter().find(|(_, p)| !p.is_empty()).unwrap_or((crate::slug_rise::PAPER_TUBE.mm, Vec::new()));
+    let speeds: Vec<String> = slugging
+        .iter()
+        .filter_map(|p| p["bed"].as_str().and_then(|b| b.rsplit("U = ").next()).map(str::to_owned))
+        .collect();
     let mean_of = |key: &str| {
         let v: Vec<f64> = slugging.iter().filter_map(|p| p[key].as_f64()).collect();
         (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
@@ -79,7 +94,7 @@ pub fn run() -> Value {
         Some(figure) => {
             json!({"name": "pressure-oscillation", "figure": figure, "reference": PAPER_CYCLES_PER_ERUPTION,
             "rel_err": figure / PAPER_CYCLES_PER_ERUPTION - 1.0, "dp_cycles_per_counted_eruption": mean_of("dp_cycles_per_eruption"),
-            "bed": "44-mm slugging beds at 0.54 and 0.60 m/s",
+            "bed": format!("{tube_mm}-mm slugging beds at {}", speeds.join(", ")),
             "note": "ΔP's dominant frequency over the bed surface's (one surface fall per eruption), both over the whole window"})
         }
     }
