@@ -106,13 +106,12 @@ pub fn try_coupled_round(sim: &mut Simulation, steps: u64, t: &mut Tally) -> Res
     let t0 = Instant::now();
     let mut left = steps;
     while left > 0 {
-        let before = sim.steps();
-        sim.advance(left).map_err(|e| e.to_string())?;
-        let taken = sim.steps() - before;
-        if taken == 0 && sim.time() >= sim.end_time() {
+        if sim.is_finished() {
             return Err(format!("the run is at its end time ({} s)", sim.end_time()));
         }
-        left -= taken;
+        let before = sim.steps();
+        sim.advance(left).map_err(|e| e.to_string())?;
+        left -= sim.steps() - before;
     }
     t.wall += t0.elapsed().as_secs_f64();
     t.steps += steps;

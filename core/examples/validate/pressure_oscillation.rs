@@ -58,7 +58,7 @@ pub fn run() -> Value {
     // is the paper tube's where one of its runs has finished.
     let mut by_tube = Vec::new();
     for tube in [crate::slug_rise::PAPER_TUBE, crate::slug_rise::BUBBLING_TUBE] {
-        let mut points = Vec::new();
+        let (mut points, mut speeds) = (Vec::new(), Vec::new());
         for u in [0.54, 0.60] {
             match crate::slug_rise::finished_at(u, tube) {
                 Some(done) => {
@@ -69,6 +69,7 @@ pub fn run() -> Value {
                     );
                     println!("{p}");
                     points.push(p);
+                    speeds.push(format!("{u} m/s"));
                 }
                 None => eprintln!(
                     "[pressure-oscillation] the {}-mm slug-rise run at U = {u} m/s has not finished; not read",
@@ -76,14 +77,9 @@ pub fn run() -> Value {
                 ),
             }
         }
-        by_tube.push((tube.mm, points));
+        by_tube.push((format!("{}-mm slugging beds at {}", tube.mm, speeds.join(", ")), points));
     }
-    let (tube_mm, slugging) =
-        by_tube.into_iter().find(|(_, p)| !p.is_empty()).unwrap_or((crate::slug_rise::PAPER_TUBE.mm, Vec::new()));
-    let speeds: Vec<String> = slugging
-        .iter()
-        .filter_map(|p| p["bed"].as_str().and_then(|b| b.rsplit("U = ").next()).map(str::to_owned))
-        .collect();
+    let (beds, slugging) = by_tube.into_iter().find(|(_, p)| !p.is_empty()).unwrap_or_default();
     let mean_of = |key: &str| {
         let v: Vec<f64> = slugging.iter().filter_map(|p| p[key].as_f64()).collect();
         (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
@@ -94,7 +90,7 @@ pub fn run() -> Value {
         Some(figure) => {
             json!({"name": "pressure-oscillation", "figure": figure, "reference": PAPER_CYCLES_PER_ERUPTION,
             "rel_err": figure / PAPER_CYCLES_PER_ERUPTION - 1.0, "dp_cycles_per_counted_eruption": mean_of("dp_cycles_per_eruption"),
-            "bed": format!("{tube_mm}-mm slugging beds at {}", speeds.join(", ")),
+            "bed": beds,
             "note": "ΔP's dominant frequency over the bed surface's (one surface fall per eruption), both over the whole window"})
         }
     }
