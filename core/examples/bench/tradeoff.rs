@@ -13,7 +13,10 @@
 //!    spin-up) alone, `gas-voidage` the reference and the gas's voidage extrapolated,
 //!    interpolated and held between couplings at intervals 10, 20, 50 alone, `scheme` the gas's
 //!    time schemes, `pressure` the particles' pressure force held or at the interval's mean at
-//!    intervals 10 and 20, `interval` the interval's mean at intervals 20, 30, 40 and 50.
+//!    intervals 10 and 20, `interval` the interval's mean at intervals 20, 30, 40 and 50, `long` intervals of 40 to
+//!    160 with the gas's voidage and the drag on the gas held or not, `probe` the settings of
+//!    `FLUIDBED_PROBE` without a reference. The bed spins up at the coupling of the fronts in
+//!    docs/BENCHMARKS.md (interval 20, the gas's voidage and drag held); each point sets its own.
 //! 2. Voidage methods on random packings in that grid (L1 against the converged exact split),
 //!    cost per particle per call and per DEM step at the case's coupling interval.
 //!
@@ -23,7 +26,7 @@
 
 use crate::coupled::{coupled_round, shipped_case, state_at, Tally};
 use crate::voidage::packing;
-use fluidbed_core::case::{BoxSplit, Case, GasVoidage, PressureForce, Voidage};
+use fluidbed_core::case::{BoxSplit, Case, GasDrag, GasVoidage, PressureForce, Voidage};
 use fluidbed_core::cfd::TimeScheme;
 use fluidbed_core::coupling::build_voidage;
 use fluidbed_core::coupling::voidage::{voidage_from_solid, ExactCylindrical, SquareGrid, VoidageMethod};
@@ -51,6 +54,11 @@ pub(crate) fn bed(seed: u64) -> Case {
     c.outputs.snapshot_interval_s = 0.002;
     c.outputs.fields = vec![fluidbed_core::case::Field::Voidage, fluidbed_core::case::Field::Pressure];
     c.end_time_s = SPIN_UP_S + WINDOW_S;
+    // The coupling the fronts spin up with and their points change (the defaults until 2026-12-06).
+    c.coupling.interval_steps = 20;
+    c.coupling.gas_voidage = GasVoidage::Held;
+    c.coupling.gas_drag = GasDrag::Held;
+    c.coupling.pressure_force = PressureForce::IntervalMean;
     if let fluidbed_core::case::Bed::Generated(g) = &mut c.bed {
         g.seed = seed;
     }
@@ -300,6 +308,71 @@ fn pressure_force_points(knob: &str, intervals: &[u32], hows: &[PressureForce]) 
     }
 }
 
+/// `-- tradeoff long`: intervals of 40 to 160 with the gas's voidage held or interpolated and
+/// the drag on the gas held or implicit (`coupling.gas_voidage`, `coupling.gas_drag`), the
+/// pressure force at the interval's mean, against the reference beside its floor.
+fn long_interval_front() {
+    let reference = bed(1);
+    let r = reference_beside_floor(&reference, &bed(2));
+    let (held, interpolated) = (GasVoidage::Held, GasVoidage::Interpolated);
+    for (voidage, drag, interval) in [
+        (held, GasDrag::Held, 40u32),
+        (held, GasDrag::Implicit, 40),
+        (interpolated, GasDrag::Held, 40),
+        (interpolated, GasDrag::Implicit, 40),
+        (interpolated, GasDrag::Held, 80),
+        (interpolated, GasDrag::Implicit, 80),
+        (interpolated, GasDrag::Implicit, 160),
+    ] {
+        let setting = format!("{voidage:?} gas voidage, {drag:?} gas drag at interval {interval}");
+        point_from_spin_up(&reference, &r, "long_interval", setting, |sim| {
+            sim.set_coupling_interval(interval);
+            sim.set_pressure_force(PressureForce::IntervalMean);
+            sim.set_gas_voidage(voidage);
+            sim.set_gas_drag(drag);
+        });
+    }
+}
+
+/// `-- tradeoff probe`: windows from the reference's spin-up at the settings of
+/// `FLUIDBED_PROBE` ("interval:gas_voidage:pressure_force:gas_drag" separated by ";", the names as
+/// in the case), each printed with its ΔP statistics and voidage profiles (no reference run).
+fn probe() {
+    let reference = bed(1);
+    let spec = std::env::var("FLUIDBED_PROBE").expect("FLUIDBED_PROBE");
+    for item in spec.split(';').filter(|s| !s.is_empty()) {
+        let f: Vec<&str> = item.split(':').collect();
+        let interval: u32 = f[0].parse().expect("interval");
+        fn parse<T: serde::de::DeserializeOwned>(s: &str) -> T {
+            serde_json::from_value(serde_json::Value::String(s.into())).expect(s)
+        }
+        let (gv, pf, gd): (GasVoidage, PressureForce, GasDrag) = (parse(f[1]), parse(f[2]), parse(f[3]));
+        let mut sim = Simulation::restore(&state_at(&reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
+        sim.set_coupling_interval(interval);
+        sim.set_gas_voidage(gv);
+        sim.set_pressure_force(pf);
+        sim.set_gas_drag(gd);
+        sim.set_end_time(SPIN_UP_S + window_s());
+        let (mut snaps, t0) = (Vec::new(), Instant::now());
+        while !sim.is_finished() {
+            match sim.advance(u64::MAX) {
+                Ok(Some(s)) => snaps.push(s),
+                Ok(None) => {}
+                Err(e) => {
+                    println!("{}", json!({"bench": "tradeoff_probe", "setting": item, "stopped": e.to_string()}));
+                    break;
+                }
+            }
+        }
+        let s = stats(&snaps, &fluid_grid(&reference));
+        println!(
+            "{}",
+            json!({"bench": "tradeoff_probe", "setting": item, "wall_s_per_sim_s": t0.elapsed().as_secs_f64() / window_s(),
+            "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
+        );
+    }
+}
+
 /// `-- tradeoff sound`: the reference window and the acoustic speed points alone.
 fn acoustic_front() {
     let reference = bed(1);
@@ -467,6 +540,14 @@ pub fn run() {
     }
     if part == "interval" {
         interval_front();
+        return;
+    }
+    if part == "probe" {
+        probe();
+        return;
+    }
+    if part == "long" {
+        long_interval_front();
         return;
     }
     if part.is_empty() || part == "cost" {

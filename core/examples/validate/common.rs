@@ -7,11 +7,12 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 /// The key a long run is kept under in target/validate-cache: the case's JSON as it was written
-/// before `coupling.pressure_force` was always written (left out when "held"), so the runs made
-/// before keep their keys.
+/// before `coupling.pressure_force` and `coupling.gas_drag` were written (left out when "held"),
+/// so the runs made before keep their keys.
 pub fn cache_key(case: &Case) -> u64 {
     let json = serde_json::to_string(case).expect("case to JSON");
-    fluidbed_core::dem::fnv1a(&json.replace(r#","pressure_force":"held""#, ""))
+    // Keys that were added with "held" as their only value keep the runs made before them.
+    fluidbed_core::dem::fnv1a(&json.replace(r#","pressure_force":"held""#, "").replace(r#","gas_drag":"held""#, ""))
 }
 
 /// A case from the project's cases/ folder.

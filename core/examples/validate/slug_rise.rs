@@ -98,6 +98,8 @@ fn case(u: f64, tube: Tube) -> Case {
     // The coupling these runs started with (the defaults until 2026-12-06): one set, one coupling.
     c.coupling.interval_steps = 10;
     c.coupling.pressure_force = fluidbed_core::case::PressureForce::Held;
+    c.coupling.gas_voidage = fluidbed_core::case::GasVoidage::Held;
+    c.coupling.gas_drag = fluidbed_core::case::GasDrag::Held;
     let report = c.validate();
     assert!(report.is_ok(), "slug-rise case invalid: {:?}", report.errors);
     c

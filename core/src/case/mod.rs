@@ -60,11 +60,11 @@ pub struct Coupling {
     /// Drag law (PHYSICS.md 1): "beetstra" (the paper's), "gidaspow" (Ergun + Wen–Yu), "di_felice".
     pub drag_law: crate::coupling::DragModel,
     /// DEM steps between recomputations of voidage and drag (1 = every step, the paper's); the
-    /// drag on each particle and on the gas is held in between, the gas still steps at its own
-    /// stable step. Default 20, with the pressure force at the interval's mean, from the
-    /// run-time/error trade-off (docs/BENCHMARKS.md, "Defaults from the front"); drag held longer
-    /// than 25 µs (interval × DEM step) warns: longer holds made the coupling oscillate
-    /// (docs/BENCHMARKS.md, "Longer intervals").
+    /// drag on each particle is held in between, the gas still steps at its own stable step.
+    /// Default 80 (100 µs at the paper's DEM step), with the gas's voidage interpolated, the drag
+    /// on the gas implicit and the pressure force at the interval's mean (docs/BENCHMARKS.md,
+    /// "Longer intervals"); an interval longer than tested for the other coupling settings warns
+    /// (25 µs with the gas's voidage held, 50 µs with the drag on the gas held, else 100 µs).
     #[serde(default = "d_coupling_interval")]
     pub interval_steps: u32,
     /// Sub-layers of each fluid layer for the voidage the drag law reads (1 = the cell's voidage,
@@ -76,10 +76,11 @@ pub struct Coupling {
     /// than the cells (docs/VALIDATION.md, "U_mf with the paper's cells and the drag voidage on sub-layers").
     #[serde(default = "d_drag_sublayers")]
     pub drag_voidage_sublayers: u32,
-    /// The gas's voidage between couplings: "held" (the paper's: each coupling's field at once;
-    /// the gas mass of each cell is held, so the change shows as a pressure step),
-    /// "interpolated" (from the previous coupling's field to the new one over the next interval,
-    /// one interval behind the particles and without steps) or "extrapolated" (the new field
+    /// The gas's voidage between couplings: "interpolated" (the default: from the previous
+    /// coupling's field to the new one over the next interval, one interval behind the particles
+    /// and without steps), "held" (the paper's: each coupling's field at once; the gas mass of
+    /// each cell is held, so the change shows as a pressure step, which sets off an oscillation
+    /// of the coupling at intervals over 25 µs) or "extrapolated" (the new field
     /// moved on at the last interval's rate: no delay, steps of the second difference only;
     /// cfd/voidage_ramp.rs).
     #[serde(default)]
@@ -94,6 +95,23 @@ pub struct Coupling {
     /// default and means "held" (`Case::from_stored_json`).
     #[serde(default)]
     pub pressure_force: PressureForce,
+    /// The drag on the gas between couplings: "implicit" (the default: linearised in the gas
+    /// velocity about the coupling's, with the particles' drag coefficient, and stepped by
+    /// backward Euler at each gas step, so that the gas's drag relaxation, ≈60 µs in a bed near
+    /// U_mf, needs no short interval; cfd/implicit_drag.rs) or "held" (the paper's: the coupling's
+    /// force, as the particles get). Always written: a stored case without it is from before
+    /// this key and means "held" (`Case::from_stored_json`).
+    #[serde(default)]
+    pub gas_drag: GasDrag,
+}
+
+/// The drag on the gas between couplings (`coupling.gas_drag`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum GasDrag {
+    Held,
+    #[default]
+    Implicit,
 }
 
 /// The particles' pressure-gradient force between couplings (`coupling.pressure_force`).
@@ -110,8 +128,8 @@ pub enum PressureForce {
 #[derive(Clone, Copy, Debug, Default, Serialize, Deserialize, JsonSchema, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum GasVoidage {
-    #[default]
     Held,
+    #[default]
     Interpolated,
     Extrapolated,
 }
@@ -122,8 +140,9 @@ impl Default for Coupling {
             drag_law: Default::default(),
             interval_steps: d_coupling_interval(),
             drag_voidage_sublayers: d_drag_sublayers(),
-            gas_voidage: GasVoidage::Held,
+            gas_voidage: GasVoidage::Interpolated,
             pressure_force: PressureForce::IntervalMean,
+            gas_drag: GasDrag::Implicit,
         }
     }
 }
@@ -133,7 +152,7 @@ fn d_drag_sublayers() -> u32 {
 }
 
 fn d_coupling_interval() -> u32 {
-    20
+    80
 }
 
 /// The cylindrical column (tube). Its axis is the z axis, the distributor plate is z = 0.
@@ -523,14 +542,15 @@ impl Case {
         serde_json::from_str(s)
     }
     /// A case as this program stored it (a checkpoint's, a job's): as `from_json`, except that
-    /// a coupling without `pressure_force` was stored before that key was always written, when
-    /// its absence meant "held", and is read so.
+    /// a coupling without `pressure_force` or `gas_drag` was stored before that key was always
+    /// written, when its absence meant "held", and is read so.
     pub fn from_stored_json(s: &str) -> Result<Case, serde_json::Error> {
         let mut v: serde_json::Value = serde_json::from_str(s)?;
         if let Some(case) = v.as_object_mut() {
             let coupling = case.entry("coupling").or_insert_with(|| serde_json::json!({}));
             if let Some(c) = coupling.as_object_mut() {
                 c.entry("pressure_force").or_insert_with(|| "held".into());
+                c.entry("gas_drag").or_insert_with(|| "held".into());
             }
         }
         serde_json::from_value(v)

@@ -136,7 +136,8 @@ fn a_stored_case_without_the_pressure_force_means_held_and_a_new_one_the_mean() 
     // A case a user submits without the key takes today's default.
     let (fresh, _) = Case::parse_str(paper_case_json()).expect("valid");
     assert_eq!(fresh.coupling.pressure_force, PressureForce::IntervalMean);
-    assert_eq!(fresh.coupling.interval_steps, 20);
+    assert_eq!(fresh.coupling.interval_steps, 80);
+    assert_eq!(fresh.coupling.gas_drag, crate::case::GasDrag::Implicit);
     // Stored cases always carry it now, and read back as written.
     let text = serde_json::to_string(&fresh).unwrap();
     assert!(text.contains(r#""pressure_force":"interval_mean""#), "{text}");
@@ -145,15 +146,18 @@ fn a_stored_case_without_the_pressure_force_means_held_and_a_new_one_the_mean() 
     // with or without a coupling section.
     let mut old: serde_json::Value = serde_json::from_str(&text).unwrap();
     old["coupling"].as_object_mut().unwrap().remove("pressure_force");
+    old["coupling"].as_object_mut().unwrap().remove("gas_drag");
     let held = Case::from_stored_json(&old.to_string()).unwrap();
     assert_eq!(held.coupling.pressure_force, PressureForce::Held);
-    assert_eq!(held.coupling.interval_steps, 20, "the other keys as stored");
+    assert_eq!(held.coupling.gas_drag, crate::case::GasDrag::Held);
+    assert_eq!(held.coupling.interval_steps, 80, "the other keys as stored");
     old.as_object_mut().unwrap().remove("coupling");
     assert_eq!(Case::from_stored_json(&old.to_string()).unwrap().coupling.pressure_force, PressureForce::Held);
 }
 
 #[test]
 fn a_drag_held_longer_than_tested_warns_and_the_default_does_not() {
+    use crate::case::{GasDrag, GasVoidage};
     let gas = |n: u32| {
         let mut c = Case::parse_str(paper_case_json()).expect("valid").0;
         c.gas = Some(Default::default());
@@ -161,18 +165,29 @@ fn a_drag_held_longer_than_tested_warns_and_the_default_does_not() {
         c
     };
     let warned = |c: &Case| c.validate().warnings.iter().any(|w| w.path == "/coupling/interval_steps");
-    // The default: 20 steps of 1.25 µs, 25 µs of held drag.
+    // The default: 80 steps of 1.25 µs, 100 µs between couplings, the gas's voidage interpolated
+    // and its drag implicit.
     assert!(!warned(&gas(d_coupling_interval())));
-    let rep = gas(30).validate();
+    let rep = gas(90).validate();
     assert!(rep.is_ok(), "a warning only: {:?}", rep.errors);
     let w = rep.warnings.iter().find(|w| w.path == "/coupling/interval_steps").expect("warned");
-    assert!(w.allowed.contains("<= 20"), "{}", w.allowed);
+    assert!(w.allowed.contains("<= 80"), "{}", w.allowed);
+    // The gas's voidage held: 25 µs; the drag on the gas held: 50 µs.
+    let mut held_voidage = gas(30);
+    held_voidage.coupling.gas_voidage = GasVoidage::Held;
+    let w =
+        held_voidage.validate().warnings.into_iter().find(|w| w.path == "/coupling/interval_steps").expect("warned");
+    assert!(w.allowed.contains("<= 20") && w.message.contains("voidage"), "{w:?}");
+    let mut held_drag = gas(50);
+    held_drag.coupling.gas_drag = GasDrag::Held;
+    let w = held_drag.validate().warnings.into_iter().find(|w| w.path == "/coupling/interval_steps").expect("warned");
+    assert!(w.allowed.contains("<= 40") && w.message.contains("drag"), "{w:?}");
     // A finer DEM step holds the drag for less time at the same count.
-    let mut fine = gas(30);
+    let mut fine = gas(90);
     fine.dem.time_step_s = 0.625e-6;
     assert!(!warned(&fine));
     // No gas, or a frozen bed, holds no drag on moving particles.
-    let mut frozen = gas(30);
+    let mut frozen = gas(90);
     frozen.dem.frozen = true;
     assert!(!warned(&frozen));
 }

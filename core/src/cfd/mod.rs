@@ -77,6 +77,7 @@ mod ab3;
 mod boundary;
 mod forward_backward;
 mod geometry;
+mod implicit_drag;
 mod mass_budget;
 mod params;
 mod rhs;

@@ -5,6 +5,7 @@ use super::ab3::{ab2_weights, ab3_weights, combine};
 use super::boundary::{outlet_layer, OutletGeometry};
 use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
+use super::implicit_drag::{self, ImplicitDrag};
 use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet, TimeScheme};
 use super::rhs::{
@@ -54,6 +55,12 @@ struct State {
     face_flux: Vec<f64>,
     #[serde(default)]
     hist_face: [Vec<f64>; 3],
+    /// `coupling.gas_drag` = "implicit": per cell the drag coefficient a and the gas velocity u₀
+    /// (Cartesian) of the last coupling (implicit_drag.rs); empty when the drag is held.
+    #[serde(default)]
+    drag_coef: Vec<f64>,
+    #[serde(default)]
+    drag_u0: Vec<[f64; 3]>,
 }
 
 /// The volume-averaged compressible gas (paper section 2.2 and Appendix A).
@@ -128,6 +135,8 @@ impl GasSolver {
             head: 0,
             face_flux: Vec::new(),
             hist_face: Default::default(),
+            drag_coef: Vec::new(),
+            drag_u0: Vec::new(),
         };
         let mut s = GasSolver::from_state(st, grid);
         s.scheme = g.time_scheme;
@@ -266,6 +275,25 @@ impl GasSolver {
     /// Interaction force per unit volume on the gas, cylindrical (r, θ, z) in each cell's basis.
     pub fn interaction_force_mut(&mut self) -> &mut [[f64; 3]] {
         &mut self.st.force
+    }
+
+    /// The drag on the gas between couplings (implicit_drag.rs): with `Some(a)` (one coefficient
+    /// per cell, kg m⁻³ s⁻¹) the interaction force is I₀ − a(u − u₀) from now on, u₀ the gas
+    /// velocity now and I₀ `interaction_force_mut`'s; `None` holds I₀.
+    pub fn set_implicit_drag(&mut self, coef: Option<&[f64]>) {
+        match coef {
+            Some(a) => {
+                assert_eq!(a.len(), self.st.q.len(), "one drag coefficient per cell");
+                self.st.drag_coef.clear();
+                self.st.drag_coef.extend_from_slice(a);
+                self.st.drag_u0.clear();
+                self.st.drag_u0.extend(self.st.q.iter().map(|s| [s[1] / s[0], s[2] / s[0], s[3] / s[0]]));
+            }
+            None => {
+                self.st.drag_coef.clear();
+                self.st.drag_u0.clear();
+            }
+        }
     }
 
     /// Set one cell's density ρ and interstitial velocity (U_r, U_θ, U_z) at its current voidage.
@@ -536,6 +564,9 @@ impl GasSolver {
             combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &fs[..=m], &w[..=m]);
             combine(&mut self.st.face_flux, &self.face_old, &gs[..=m], &w[..=m]);
         }
+        if let Some(d) = implicit_drag_of(&self.st.drag_coef, &self.st.drag_u0) {
+            implicit_drag::apply(&mut self.st.q, d, dt);
+        }
         if hl > 0 {
             self.budget.net += self.multistep_inflow(&w[..=m], net_new);
         }
@@ -551,6 +582,9 @@ impl GasSolver {
                 &[0.5 * dt, 0.5 * dt],
             );
             combine(&mut self.st.face_flux, &self.face_old, &[&g_new, &face_stage], &[0.5 * dt, 0.5 * dt]);
+            if let Some(d) = implicit_drag_of(&self.st.drag_coef, &self.st.drag_u0) {
+                implicit_drag::apply(&mut self.st.q, d, dt);
+            }
             let net_stage = self.net_inflow(t + dt);
             self.budget.net += 0.5 * dt * net_new + 0.5 * dt * net_stage;
             (self.stage, self.face_stage) = (stage, face_stage);
@@ -571,6 +605,9 @@ impl GasSolver {
         let fs = [f_new.as_flattened(), h[i1].as_flattened(), h[i2].as_flattened()];
         combine(self.st.q.as_flattened_mut(), self.q_old.as_flattened(), &fs[..=m], &w[..=m]);
         add_pressure_force(&mut self.st.q, &self.st.eps, &self.prim.view(), dt);
+        if let Some(d) = implicit_drag_of(&self.st.drag_coef, &self.st.drag_u0) {
+            implicit_drag::apply(&mut self.st.q, d, dt);
+        }
         combine(&mut self.st.face_flux, &self.face_old, &[&g_new], &[dt]);
         let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
         let inp = state_input(&self.st, &self.geo, &self.grid, t);
@@ -611,6 +648,7 @@ impl GasSolver {
             nz: self.grid.nz,
             eps: &self.st.eps,
             force: &self.st.force,
+            drag: implicit_drag_of(&self.st.drag_coef, &self.st.drag_u0),
             time: self.st.time,
             dt,
             weights,
@@ -799,6 +837,11 @@ impl GasSolver {
 }
 
 /// What the right-hand side reads besides the cells' state, at time t.
+/// The implicit drag's arrays when `coupling.gas_drag` is "implicit".
+fn implicit_drag_of<'a>(coef: &'a [f64], u0: &'a [[f64; 3]]) -> Option<ImplicitDrag<'a>> {
+    (!coef.is_empty()).then_some(ImplicitDrag { coef, u0 })
+}
+
 fn state_input<'a>(st: &'a State, geo: &'a FaceGeometry, grid: &CylGrid, t: f64) -> RhsInput<'a> {
     RhsInput {
         geo,

@@ -11,6 +11,7 @@ use super::ab3::combine;
 use super::boundary::{outlet_layer, OutletGeometry};
 use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
+use super::implicit_drag::{self, ImplicitDrag};
 use super::params::{GasParams, Outlet};
 use super::rhs::{PrimView, Primitives, RhsInput};
 use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
@@ -24,6 +25,8 @@ pub(super) struct StepInput<'a> {
     pub nz: usize,
     pub eps: &'a [f64],
     pub force: &'a [[f64; 3]],
+    /// The drag on the gas stepped implicitly after the momentum's other terms (implicit_drag.rs).
+    pub drag: Option<ImplicitDrag<'a>>,
     pub time: f64,
     pub dt: f64,
     /// The AB weights times the step: of the new right-hand side, then of `past` (one or two).
@@ -187,6 +190,7 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
                 let w = inp.weights;
                 unsafe {
                     multistep_cells(inp, [q, q_old, rhs], c0, c1);
+                    own_implicit_drag(inp, q.part(c0, c1), c0, c1);
                     for (lo, hi) in [(c0, c1), (f0, f1)] {
                         let (y, y0, f) = (face.part(lo, hi), face_old.view(lo, hi), rhs_face.view(lo, hi));
                         let mut fs: [&[f64]; 3] = [f, &[], &[]];
@@ -246,6 +250,13 @@ unsafe fn multistep_cells(inp: &StepInput, [q, q_old, rhs]: [Raw<[f64; 4]>; 3], 
     combine(q.part(c0, c1).as_flattened_mut(), q_old.view(c0, c1).as_flattened(), &fs[..w.len()], w);
 }
 
+/// The implicit drag step (implicit_drag.rs) of the cells c0..c1, `q` their rows.
+fn own_implicit_drag(inp: &StepInput, q: &mut [[f64; 4]], c0: usize, c1: usize) {
+    if let Some(d) = inp.drag {
+        implicit_drag::apply(q, ImplicitDrag { coef: &d.coef[c0..c1], u0: &d.u0[c0..c1] }, inp.dt);
+    }
+}
+
 /// A thread's block: its layers k0..k1 and its horizontal-face rows f0..f1.
 struct Rows {
     k: (usize, usize),
@@ -285,6 +296,7 @@ unsafe fn forward_backward_rows(inp: &StepInput, a: &FbArrays, barrier: &SpinBar
         without_pressure_force(f, e, &own);
         multistep_cells(inp, [a.q, a.q_old, a.rhs], c0, c1);
         add_pressure_force(a.q.part(c0, c1), e, &own, inp.dt);
+        own_implicit_drag(inp, a.q.part(c0, c1), c0, c1);
         for (lo, hi) in [(c0, c1), (f0, f1)] {
             let (y, y0, f) = (a.face.part(lo, hi), a.face_old.view(lo, hi), a.rhs_face.view(lo, hi));
             combine(y, y0, &[f], &[inp.dt]);

@@ -122,6 +122,8 @@ struct CellTable<C> {
     grad_cyl: [f64; 3],
     k: f64,
     re_per_w: f64,
+    /// ∂u_s/∂u_c: the drag velocity per cell velocity (1 on the fluid cells, ε_c/ε_s on sub-layers).
+    u_per_cell_u: f64,
     basis: (f64, f64),
     law: C,
 }
@@ -139,6 +141,9 @@ pub struct Exchange {
     /// Drag on the gas per chunk and cell (cell basis) of the layers that hold particles, summed
     /// into the caller's output.
     chunk_force: Vec<Vec<[f64; 3]>>,
+    /// Σ K_p·∂u_s/∂u_c per chunk and cell, and the cells' sums over V_cell (`drag_coefficients`).
+    chunk_coef: Vec<Vec<f64>>,
+    cell_coef: Vec<f64>,
     /// Sub-layers: the pressure correction the gas loses per sub-cell, and scratch (sublayer_pressure.rs).
     sub_lost: Vec<[f64; 3]>,
     sub_scratch: Vec<[f64; 3]>,
@@ -173,6 +178,8 @@ impl Exchange {
             frozen: Vec::new(),
             tables: Tables::default(),
             chunk_force: vec![Vec::new(); CHUNKS],
+            chunk_coef: vec![Vec::new(); CHUNKS],
+            cell_coef: Vec::new(),
             sub_lost: Vec::new(),
             sub_scratch: Vec::new(),
             sub_count: Vec::new(),
@@ -244,17 +251,14 @@ impl Exchange {
             let c = fluid_cell(s, per, m);
             let eps = clamp_voidage(drag.voidage[s], par.eps_min);
             let u = gas.velocity_cyl[c];
-            let u_cyl = if m == 1 {
-                u
-            } else {
-                let f = clamp_voidage(gas.voidage[c], par.eps_min) / eps;
-                [f * u[0], f * u[1], f * u[2]]
-            };
+            let f = if m == 1 { 1.0 } else { clamp_voidage(gas.voidage[c], par.eps_min) / eps };
+            let u_cyl = if m == 1 { u } else { [f * u[0], f * u[1], f * u[2]] };
             *t = CellTable {
                 u_cyl,
                 grad_cyl: gas.grad_p_cyl[c],
                 k: 3.0 * PI * mu * d * eps,
                 re_per_w: gas.density[c] * eps * d / mu,
+                u_per_cell_u: f,
                 basis: basis[s % per],
                 law: law.cell(eps),
             };
@@ -269,16 +273,23 @@ impl Exchange {
         let dgrid = drag.grid;
         // The chunks' sums over the used cells; rows of chunks without particles add nothing.
         self.chunk_force.resize_with(CHUNKS, Vec::new);
-        for row in &mut self.chunk_force[pos.len().div_ceil(chunk)..] {
+        self.chunk_coef.resize_with(CHUNKS, Vec::new);
+        let filled = pos.len().div_ceil(chunk);
+        for (row, coef) in self.chunk_force[filled..].iter_mut().zip(&mut self.chunk_coef[filled..]) {
             resize_reused(row, used, [0.0; 3]);
             row.fill([0.0; 3]);
+            resize_reused(coef, used, 0.0);
+            coef.fill(0.0);
         }
-        (self.chunk_force.par_iter_mut(), force_out.par_chunks_mut(chunk), self.cell_of.par_chunks_mut(chunk))
+        let sums = self.chunk_force.par_iter_mut().zip(self.chunk_coef.par_iter_mut());
+        (sums, force_out.par_chunks_mut(chunk), self.cell_of.par_chunks_mut(chunk))
             .into_par_iter()
             .enumerate()
-            .for_each(|(n, (sum, f, co))| {
+            .for_each(|(n, ((sum, coef), f, co))| {
                 resize_reused(sum, used, [0.0; 3]);
                 sum.fill([0.0; 3]);
+                resize_reused(coef, used, 0.0);
+                coef.fill(0.0);
                 let lo = n * chunk;
                 particle_block_pass_on::<L>(
                     dgrid,
@@ -288,7 +299,7 @@ impl Exchange {
                     &vel[lo..lo + f.len()],
                     f,
                     co,
-                    sum,
+                    (sum, coef),
                 );
             });
         // 3. with sub-layers, each particle's share of its sub-cell's pressure drop
@@ -331,9 +342,26 @@ impl Exchange {
             }
             *out = [-s[0] * inv_v, -s[1] * inv_v, -s[2] * inv_v];
         });
+        let coefs = &self.chunk_coef;
+        resize_reused(&mut self.cell_coef, cells, 0.0);
+        let (below, above) = self.cell_coef.split_at_mut(used / m);
+        above.fill(0.0);
+        below.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
+            let first = (c / per) * m * per + c % per;
+            let s: f64 = (0..m).map(|sub| coefs.iter().map(|row| row[first + sub * per]).sum::<f64>()).sum();
+            *out = s * inv_v;
+        });
         for row in &mut self.chunk_force[CHUNKS..] {
             row.clear();
         }
+    }
+
+    /// Per fluid cell, the drag coefficient of the gas at the last `particle_gas_forces` (or
+    /// `frozen_cell_forces`, whose particles are at rest):
+    /// a = Σ_p K_p·∂u_s/∂u_c / V_cell (kg m⁻³ s⁻¹), K_p = 3πμdεF the particle's drag per slip, so
+    /// that ∂I/∂u ≈ −a at the call's Re (cfd/implicit_drag.rs).
+    pub fn drag_coefficients(&self) -> &[f64] {
+        &self.cell_coef
     }
 
     /// The drag cell of each particle at the last `particle_gas_forces` (the particles' order then).
@@ -395,7 +423,7 @@ impl Exchange {
     /// N, C = Σcos, S = Σsin over the cell's particles. Equal to `Exchange::particle_gas_forces`' gas side
     /// to round-off; the particles' own forces are not needed (they do not move).
     pub fn frozen_cell_forces(
-        &self,
+        &mut self,
         grid: &CylGrid,
         gas: &GasAtCells,
         par: ExchangeParams,
@@ -403,8 +431,11 @@ impl Exchange {
     ) {
         assert_eq!(self.frozen.len(), grid.num_cells(), "freeze() first");
         let inv_v = 1.0 / grid.cell_volume();
+        resize_reused(&mut self.cell_coef, grid.num_cells(), 0.0);
+        self.cell_coef.fill(0.0);
         let (law, mu, eps_min, d) = (par.law, par.mu, par.eps_min, par.d);
-        for (c, (f, &(n, cs, sn))) in cell_force_out.iter_mut().zip(&self.frozen).enumerate() {
+        let (frozen, cell_coef) = (&self.frozen, &mut self.cell_coef);
+        for (c, (f, &(n, cs, sn))) in cell_force_out.iter_mut().zip(frozen).enumerate() {
             if n == 0.0 {
                 *f = [0.0; 3];
                 continue;
@@ -423,6 +454,7 @@ impl Exchange {
                 -coef * (sn * u[0] + cs * u[1]) * inv_v,
                 -coef * n * u[2] * inv_v,
             ];
+            cell_coef[c] = coef * n * inv_v;
         }
     }
 }
@@ -431,7 +463,7 @@ per_isa!(
     /// `particle_block_pass` on the best vector path the CPU has (`simd::per_isa`): the same
     /// operations in the same order, so the same bits.
     fn particle_block_pass_on<L: DragLaw>, particle_pass_paths, particle_block_pass,
-    (grid: &CylGrid, table: &[CellTable<L::Cell>], vp: f64, pos: &[[f64; 3]], vel: &[[f64; 3]], force: &mut [[f64; 3]], cell_of: &mut [u32], gas_sum: &mut [[f64; 3]])
+    (grid: &CylGrid, table: &[CellTable<L::Cell>], vp: f64, pos: &[[f64; 3]], vel: &[[f64; 3]], force: &mut [[f64; 3]], cell_of: &mut [u32], gas_sum: (&mut [[f64; 3]], &mut [f64]))
 );
 
 /// One chunk of the particle pass, in blocks of `BLOCK` particles: the cell and the gas state
@@ -447,7 +479,7 @@ fn particle_block_pass<L: DragLaw>(
     vel: &[[f64; 3]],
     force: &mut [[f64; 3]],
     cell_of: &mut [u32],
-    gas_sum: &mut [[f64; 3]],
+    (gas_sum, coef_sum): (&mut [[f64; 3]], &mut [f64]),
 ) {
     let mut lane_cell = [L::Cell::default(); BLOCK];
     let (mut re, mut f) = ([0.0; BLOCK], [0.0; BLOCK]);
@@ -495,6 +527,7 @@ fn particle_block_pass<L: DragLaw>(
             for q in 0..3 {
                 out[q] += dc[q];
             }
+            coef_sum[c] += kf * t.u_per_cell_u;
         }
     }
 }
@@ -641,6 +674,46 @@ mod tests {
         }
     }
 
+    /// The gas's drag coefficient (cfd/implicit_drag.rs) is Σ 3πμdεF(ε, Re) over each cell's
+    /// particles per cell volume, F the law's published form at each particle's own slip.
+    #[test]
+    fn the_drag_coefficient_sums_the_particles_drag_per_slip() {
+        let g = grid();
+        let n = g.num_cells();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        let m = 2000;
+        let scene = RandomScene::new(&mut rng, n, m, true);
+        let gas = scene.gas();
+        let (mu, d) = (1.8e-5, 1.2e-3);
+        let par = ExchangeParams { law: DragModel::Beetstra, mu, eps_min: 0.1, d };
+        let (mut f, mut cf) = (vec![[0.0; 3]; m], vec![[0.0; 3]; n]);
+        let mut ex = Exchange::new(&g, m);
+        ex.particle_gas_forces(
+            &g,
+            DragCells::cells(&g, gas.voidage),
+            &gas,
+            par,
+            (&scene.pos, &scene.vel),
+            &mut f,
+            &mut cf,
+        );
+        let mut want = vec![0.0; n];
+        for (p, v) in scene.pos.iter().zip(&scene.vel) {
+            let c = g.locate(p[0], p[1], p[2]);
+            let (cos, sin) = angle_of(p[0], p[1]);
+            let u = cyl_to_cart(scene.vel_c[c], cos, sin);
+            let slip = [u[0] - v[0], u[1] - v[1], u[2] - v[2]];
+            let w = (slip[0] * slip[0] + slip[1] * slip[1] + slip[2] * slip[2]).sqrt();
+            let eps = clamp_voidage(scene.void[c], 0.1);
+            let re = scene.dens[c] * eps * w * d / mu;
+            want[c] += 3.0 * PI * mu * d * eps * beetstra_f(eps, re) / g.cell_volume();
+        }
+        for (c, (got, want)) in ex.drag_coefficients().iter().zip(&want).enumerate() {
+            assert!((got - want).abs() <= 1e-12 * want.abs(), "cell {c}: {got} vs {want}");
+        }
+        assert!(want.iter().filter(|&&a| a > 0.0).count() > n / 2, "most cells hold particles");
+    }
+
     #[test]
     fn momentum_is_conserved_between_the_phases() {
         let g = grid();
@@ -701,6 +774,7 @@ mod tests {
                 grad_cyl: [rng.gen_range(-50.0..50.0), rng.gen_range(-50.0..50.0), -6000.0],
                 k: rng.gen_range(1e-10..1e-9),
                 re_per_w: rng.gen_range(10.0..100.0),
+                u_per_cell_u: rng.gen_range(0.8..1.2),
                 basis: (c as f64).sin_cos(),
                 law: Beetstra.cell(rng.gen_range(0.35..1.0)),
             })
@@ -721,16 +795,27 @@ mod tests {
             (0..m).map(|_| [rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5), rng.gen_range(-0.5..0.5)]).collect();
         let run = |best: bool| {
             let (mut f, mut co, mut sum) = (vec![[0.0; 3]; m], vec![0u32; m], vec![[0.0; 3]; n]);
+            let mut coef = vec![0.0; n];
             if best {
-                particle_block_pass_on::<Beetstra>(&g, &table, 1e-9, &pos, &vel, &mut f, &mut co, &mut sum);
+                particle_block_pass_on::<Beetstra>(
+                    &g,
+                    &table,
+                    1e-9,
+                    &pos,
+                    &vel,
+                    &mut f,
+                    &mut co,
+                    (&mut sum, &mut coef),
+                );
             } else {
-                particle_block_pass::<Beetstra>(&g, &table, 1e-9, &pos, &vel, &mut f, &mut co, &mut sum);
+                particle_block_pass::<Beetstra>(&g, &table, 1e-9, &pos, &vel, &mut f, &mut co, (&mut sum, &mut coef));
             }
             let bits = |v: &[[f64; 3]]| v.iter().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
-            (bits(&f), co, bits(&sum))
+            let coef_bits: Vec<u64> = coef.iter().map(|x| x.to_bits()).collect();
+            (bits(&f), co, bits(&sum), coef_bits)
         };
         let (portable, best) = (run(false), run(true));
-        assert!(portable.1 == best.1 && portable.0 == best.0 && portable.2 == best.2, "the paths differ");
+        assert!(portable == best, "the paths differ");
     }
 
     #[test]

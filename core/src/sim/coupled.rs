@@ -9,7 +9,7 @@
 //! (coupling/exchange.rs, `windowed_voidage`).
 
 use super::{watchdog, SimError, Simulation};
-use crate::case::{GasVoidage, PressureForce};
+use crate::case::{GasDrag, GasVoidage, PressureForce};
 use crate::coupling::{
     layers_with_particles, voidage_from_solid, DragCells, Exchange, ExchangeParams, GasAtCells, VoidageMethod,
 };
@@ -174,6 +174,8 @@ impl Simulation {
             b.exchange.frozen_cell_forces(&self.grid, &at, par, &mut b.cell_force);
         }
         gas.interaction_force_mut().copy_from_slice(&b.cell_force);
+        let implicit = self.st.case.coupling.gas_drag == GasDrag::Implicit;
+        gas.set_implicit_drag(implicit.then(|| b.exchange.drag_coefficients()));
         if per_particle && self.st.case.coupling.pressure_force == PressureForce::GasStep {
             let stamp = (self.st.dem.list_builds().0, gas.steps());
             let m = b.sub.as_ref().map_or(1, |s| s.n);

@@ -209,6 +209,10 @@ impl Simulation {
     pub fn set_pressure_force(&mut self, how: crate::case::PressureForce) {
         self.st.case.coupling.pressure_force = how;
     }
+    /// The drag on the gas between couplings from the next coupling on (`coupling.gas_drag`).
+    pub fn set_gas_drag(&mut self, how: crate::case::GasDrag) {
+        self.st.case.coupling.gas_drag = how;
+    }
     /// Change the set superficial velocity from now on (no new ramp); used by the U_mf sweep.
     pub fn set_superficial_velocity(&mut self, u: f64) {
         if let Some(g) = self.st.case.gas.as_mut() {
