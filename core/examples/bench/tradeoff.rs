@@ -160,17 +160,25 @@ fn window_as(case: &Case, label: &str, interval: u32, how: GasVoidage) -> (Vec<S
         // The reference is the paper's coupling: every step, the pressure force of the moment.
         sim.set_pressure_force(PressureForce::Held);
     }
+    let (snaps, cost, stopped) = run_window(&mut sim);
+    assert!(stopped.is_none(), "stable run: {stopped:?}");
+    (snaps, cost)
+}
+
+/// Run `sim` from its spin-up state over the window: its snapshots, the wall seconds per
+/// simulated second, and why the watchdog stopped it, if it did.
+fn run_window(sim: &mut Simulation) -> (Vec<Snapshot>, f64, Option<String>) {
     let window = window_s();
     sim.set_end_time(SPIN_UP_S + window);
-    let mut snaps = Vec::new();
-    let t0 = Instant::now();
+    let (mut snaps, t0) = (Vec::new(), Instant::now());
     while !sim.is_finished() {
-        if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
-            snaps.push(s);
+        match sim.advance(u64::MAX) {
+            Ok(Some(s)) => snaps.push(s),
+            Ok(None) => {}
+            Err(e) => return (snaps, t0.elapsed().as_secs_f64() / window, Some(e.to_string())),
         }
     }
-    let wall = t0.elapsed().as_secs_f64();
-    (snaps, wall / window)
+    (snaps, t0.elapsed().as_secs_f64() / window, None)
 }
 
 fn coupled_front() -> f64 {
@@ -249,15 +257,8 @@ fn reference_beside_floor(reference: &Case, floor_case: &Case) -> Stats {
 fn point_from_spin_up(reference: &Case, r: &Stats, knob: &str, setting: String, set: impl FnOnce(&mut Simulation)) {
     let mut sim = Simulation::restore(&state_at(reference, SPIN_UP_S, "tradeoff-seed1")).expect("state");
     set(&mut sim);
-    let window = window_s();
-    sim.set_end_time(SPIN_UP_S + window);
-    let (mut snaps, t0) = (Vec::new(), Instant::now());
-    while !sim.is_finished() {
-        if let Some(s) = sim.advance(u64::MAX).expect("stable run") {
-            snaps.push(s);
-        }
-    }
-    let cost = t0.elapsed().as_secs_f64() / window;
+    let (snaps, cost, stopped) = run_window(&mut sim);
+    assert!(stopped.is_none(), "stable run: {stopped:?}");
     let s = stats(&snaps, &fluid_grid(reference));
     println!(
         "{}",
@@ -352,22 +353,11 @@ fn probe() {
         sim.set_gas_voidage(gv);
         sim.set_pressure_force(pf);
         sim.set_gas_drag(gd);
-        sim.set_end_time(SPIN_UP_S + window_s());
-        let (mut snaps, t0) = (Vec::new(), Instant::now());
-        while !sim.is_finished() {
-            match sim.advance(u64::MAX) {
-                Ok(Some(s)) => snaps.push(s),
-                Ok(None) => {}
-                Err(e) => {
-                    println!("{}", json!({"bench": "tradeoff_probe", "setting": item, "stopped": e.to_string()}));
-                    break;
-                }
-            }
-        }
+        let (snaps, cost, stopped) = run_window(&mut sim);
         let s = stats(&snaps, &fluid_grid(&reference));
         println!(
             "{}",
-            json!({"bench": "tradeoff_probe", "setting": item, "wall_s_per_sim_s": t0.elapsed().as_secs_f64() / window_s(),
+            json!({"bench": "tradeoff_probe", "setting": item, "wall_s_per_sim_s": cost, "stopped": stopped,
             "dp_mean_pa": s.dp_mean, "dp_std_pa": s.dp_std, "dp_freq_hz": s.dp_freq})
         );
     }
@@ -520,35 +510,23 @@ pub fn run() {
     if part.is_empty() || part == "errors" {
         coupled_front();
     }
-    if part == "gas-voidage" {
-        gas_voidage_front();
-        return;
+    let alone: Option<fn()> = match part.as_str() {
+        "gas-voidage" => Some(gas_voidage_front),
+        "scheme" => Some(scheme_front),
+        "pressure" => Some(pressure_front),
+        "interval" => Some(interval_front),
+        "probe" => Some(probe),
+        "long" => Some(long_interval_front),
+        _ => None,
+    };
+    if let Some(front) = alone {
+        return front();
     }
     if part == "layer" {
         layer_front();
     }
     if part == "sound" {
         acoustic_front();
-    }
-    if part == "scheme" {
-        scheme_front();
-        return;
-    }
-    if part == "pressure" {
-        pressure_front();
-        return;
-    }
-    if part == "interval" {
-        interval_front();
-        return;
-    }
-    if part == "probe" {
-        probe();
-        return;
-    }
-    if part == "long" {
-        long_interval_front();
-        return;
     }
     if part.is_empty() || part == "cost" {
         interleaved_costs();

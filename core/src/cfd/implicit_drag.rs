@@ -13,16 +13,25 @@
 //! overshoots once T passes the relaxation time D/a (≈ 60 µs in a bed near U_mf); implicit, by
 //! 1/(1 + T·a/D) at any T (docs/BENCHMARKS.md, "What sets off the oscillation; intervals of 80").
 
-/// The gas side of the coupling for `apply`: per cell a (kg m⁻³ s⁻¹) and u₀ (Cartesian).
+/// The gas side of the coupling for `apply`: per cell a (kg m⁻³ s⁻¹) and u₀ (Cartesian), for the
+/// first cells of the grid (those up to the bed's top); the cells past them have a = 0.
 #[derive(Clone, Copy)]
 pub struct ImplicitDrag<'a> {
     pub coef: &'a [f64],
     pub u0: &'a [[f64; 3]],
 }
 
-/// The implicit drag step of the cells `q` (ρε, ρεu_x, ρεu_y, ρεu_z), `drag` of the same cells.
+impl<'a> ImplicitDrag<'a> {
+    /// The cells c0..c1 (those of them that `self` holds).
+    pub fn cells(self, c0: usize, c1: usize) -> ImplicitDrag<'a> {
+        let (lo, hi) = (c0.min(self.coef.len()), c1.min(self.coef.len()));
+        ImplicitDrag { coef: &self.coef[lo..hi], u0: &self.u0[lo..hi] }
+    }
+}
+
+/// The implicit drag step of the cells `q` (ρε, ρεu_x, ρεu_y, ρεu_z), `drag` of its first cells.
 pub fn apply(q: &mut [[f64; 4]], drag: ImplicitDrag, dt: f64) {
-    assert!(drag.coef.len() == q.len() && drag.u0.len() == q.len(), "one coefficient per cell");
+    assert!(drag.coef.len() == drag.u0.len() && drag.coef.len() <= q.len(), "a coefficient per cell");
     for ((s, &a), u0) in q.iter_mut().zip(drag.coef).zip(drag.u0) {
         let k = dt * a;
         let inv = 1.0 / (1.0 + k / s[0]);
@@ -61,14 +70,16 @@ mod tests {
     }
 
     /// At the coupling's own gas velocity the implicit term adds nothing to the explicit I₀, and
-    /// a cell without particles (a = 0) is left alone.
+    /// a cell without particles (a = 0, or past the coefficients given) is left alone.
     #[test]
     fn at_the_couplings_velocity_and_without_particles_it_changes_nothing() {
-        let u0 = [[0.3, 0.1, 0.9], [1.0, 2.0, 3.0]];
-        let d = [0.48, 1.2];
-        let mut q: Vec<[f64; 4]> = (0..2).map(|c| [d[c], d[c] * u0[c][0], d[c] * u0[c][1], d[c] * u0[c][2]]).collect();
+        let u0 = [[0.3, 0.1, 0.9], [1.0, 2.0, 3.0], [-0.5, 0.0, 4.0]];
+        let d = [0.48, 1.2, 1.1];
+        let mut q: Vec<[f64; 4]> = (0..3).map(|c| [d[c], d[c] * u0[c][0], d[c] * u0[c][1], d[c] * u0[c][2]]).collect();
         let before = q.clone();
-        apply(&mut q, ImplicitDrag { coef: &[3000.0, 0.0], u0: &u0 }, 6.25e-6);
+        let drag = ImplicitDrag { coef: &[3000.0, 0.0], u0: &u0[..2] };
+        apply(&mut q, drag, 6.25e-6);
+        assert_eq!(drag.cells(1, 3).coef, &[0.0], "a thread's cells past the given ones hold none");
         for (s, b) in q.iter().zip(&before) {
             for i in 0..4 {
                 assert!((s[i] - b[i]).abs() <= 1e-15 * b[i].abs(), "{s:?} vs {b:?}");

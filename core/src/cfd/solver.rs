@@ -279,20 +279,16 @@ impl GasSolver {
 
     /// The drag on the gas between couplings (implicit_drag.rs): with `Some(a)` (one coefficient
     /// per cell, kg m⁻³ s⁻¹) the interaction force is I₀ − a(u − u₀) from now on, u₀ the gas
-    /// velocity now and I₀ `interaction_force_mut`'s; `None` holds I₀.
+    /// velocity now and I₀ `interaction_force_mut`'s; `None` holds I₀. Only the cells up to the
+    /// last one with a > 0 are kept: the freeboard above a bed holds no particle.
     pub fn set_implicit_drag(&mut self, coef: Option<&[f64]>) {
-        match coef {
-            Some(a) => {
-                assert_eq!(a.len(), self.st.q.len(), "one drag coefficient per cell");
-                self.st.drag_coef.clear();
-                self.st.drag_coef.extend_from_slice(a);
-                self.st.drag_u0.clear();
-                self.st.drag_u0.extend(self.st.q.iter().map(|s| [s[1] / s[0], s[2] / s[0], s[3] / s[0]]));
-            }
-            None => {
-                self.st.drag_coef.clear();
-                self.st.drag_u0.clear();
-            }
+        self.st.drag_coef.clear();
+        self.st.drag_u0.clear();
+        if let Some(a) = coef {
+            assert_eq!(a.len(), self.st.q.len(), "one drag coefficient per cell");
+            let n = a.iter().rposition(|&x| x != 0.0).map_or(0, |c| c + 1);
+            self.st.drag_coef.extend_from_slice(&a[..n]);
+            self.st.drag_u0.extend(self.st.q[..n].iter().map(interstitial_velocity));
         }
     }
 
@@ -317,8 +313,7 @@ impl GasSolver {
     }
     /// Interstitial Cartesian velocity (u_x, u_y, u_z).
     pub fn velocity_xyz(&self, cell: usize) -> [f64; 3] {
-        let s = self.st.q[cell];
-        [s[1] / s[0], s[2] / s[0], s[3] / s[0]]
+        interstitial_velocity(&self.st.q[cell])
     }
     /// Velocity on the axis in layer k: the central annulus' velocities converted to x, y and
     /// averaged (paper section 2.2).
@@ -837,6 +832,11 @@ impl GasSolver {
 }
 
 /// What the right-hand side reads besides the cells' state, at time t.
+/// u = ρεu / ρε of a cell's state (Cartesian).
+fn interstitial_velocity(s: &[f64; 4]) -> [f64; 3] {
+    [s[1] / s[0], s[2] / s[0], s[3] / s[0]]
+}
+
 /// The implicit drag's arrays when `coupling.gas_drag` is "implicit".
 fn implicit_drag_of<'a>(coef: &'a [f64], u0: &'a [[f64; 3]]) -> Option<ImplicitDrag<'a>> {
     (!coef.is_empty()).then_some(ImplicitDrag { coef, u0 })

@@ -253,7 +253,7 @@ unsafe fn multistep_cells(inp: &StepInput, [q, q_old, rhs]: [Raw<[f64; 4]>; 3], 
 /// The implicit drag step (implicit_drag.rs) of the cells c0..c1, `q` their rows.
 fn own_implicit_drag(inp: &StepInput, q: &mut [[f64; 4]], c0: usize, c1: usize) {
     if let Some(d) = inp.drag {
-        implicit_drag::apply(q, ImplicitDrag { coef: &d.coef[c0..c1], u0: &d.u0[c0..c1] }, inp.dt);
+        implicit_drag::apply(q, d.cells(c0, c1), inp.dt);
     }
 }
 

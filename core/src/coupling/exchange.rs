@@ -318,21 +318,24 @@ impl Exchange {
             };
             add_sublayer_pressure(&d, force_out, &mut self.sub_lost, (&mut self.sub_scratch, &mut self.sub_count));
         }
-        // 4. the gas loses the drag (and the sub-layers' pressure correction) in its cell: chunk
-        //    sums and sub-cells in a fixed order, per unit volume
+        // 4. the gas loses the drag (and the sub-layers' pressure correction) in its cell, with its
+        //    drag coefficient: chunk sums and sub-cells in a fixed order, per unit volume
         let inv_v = 1.0 / grid.cell_volume();
-        let sums = &self.chunk_force;
-        let lost = &self.sub_lost;
+        let (sums, coefs, lost) = (&self.chunk_force, &self.chunk_coef, &self.sub_lost);
+        resize_reused(&mut self.cell_coef, cells, 0.0);
         let (below, above) = cell_force_out.split_at_mut(used / m);
+        let (coef_below, coef_above) = self.cell_coef.split_at_mut(used / m);
         above.fill([0.0; 3]);
-        below.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
-            let mut s = [0.0; 3];
+        coef_above.fill(0.0);
+        below.par_iter_mut().zip(coef_below).with_min_len(512).enumerate().for_each(|(c, (out, coef))| {
+            let (mut s, mut a) = ([0.0; 3], 0.0);
             let first = (c / per) * m * per + c % per;
             for sub in 0..m {
-                for row in sums {
+                for (row, row_coef) in sums.iter().zip(coefs) {
                     for q in 0..3 {
                         s[q] += row[first + sub * per][q];
                     }
+                    a += row_coef[first + sub * per];
                 }
                 if m > 1 {
                     for q in 0..3 {
@@ -341,15 +344,7 @@ impl Exchange {
                 }
             }
             *out = [-s[0] * inv_v, -s[1] * inv_v, -s[2] * inv_v];
-        });
-        let coefs = &self.chunk_coef;
-        resize_reused(&mut self.cell_coef, cells, 0.0);
-        let (below, above) = self.cell_coef.split_at_mut(used / m);
-        above.fill(0.0);
-        below.par_iter_mut().with_min_len(512).enumerate().for_each(|(c, out)| {
-            let first = (c / per) * m * per + c % per;
-            let s: f64 = (0..m).map(|sub| coefs.iter().map(|row| row[first + sub * per]).sum::<f64>()).sum();
-            *out = s * inv_v;
+            *coef = a * inv_v;
         });
         for row in &mut self.chunk_force[CHUNKS..] {
             row.clear();
