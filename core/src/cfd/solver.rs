@@ -831,7 +831,6 @@ impl GasSolver {
     }
 }
 
-/// What the right-hand side reads besides the cells' state, at time t.
 /// u = ρεu / ρε of a cell's state (Cartesian).
 fn interstitial_velocity(s: &[f64; 4]) -> [f64; 3] {
     [s[1] / s[0], s[2] / s[0], s[3] / s[0]]
@@ -842,6 +841,7 @@ fn implicit_drag_of<'a>(coef: &'a [f64], u0: &'a [[f64; 3]]) -> Option<ImplicitD
     (!coef.is_empty()).then_some(ImplicitDrag { coef, u0 })
 }
 
+/// What the right-hand side reads besides the cells' state, at time t.
 fn state_input<'a>(st: &'a State, geo: &'a FaceGeometry, grid: &CylGrid, t: f64) -> RhsInput<'a> {
     RhsInput {
         geo,
