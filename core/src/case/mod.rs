@@ -413,6 +413,24 @@ pub struct Gas {
     /// 7, on the whole right-hand side); docs/VALIDATION.md "Forward–backward gas step".
     #[serde(default, skip_serializing_if = "crate::cfd::TimeScheme::is_default")]
     pub time_scheme: crate::cfd::TimeScheme,
+    /// A jet through the distributor's inner annuli over a time window (absent: the paper's uniform
+    /// distributor); e.g. one injected bubble in a bed held at U_mf.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inlet_jet: Option<InletJet>,
+}
+
+/// `gas.inlet_jet`: the inlet cells of the grid's `annuli` inner annuli (radius annuli·dr) blow at
+/// their own superficial velocity from `from_s` until `until_s` (absent: to the end), the rest of
+/// the distributor at `superficial_velocity_m_s`; the inlet ramp applies to both.
+#[derive(Clone, Debug, Serialize, Deserialize, JsonSchema, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct InletJet {
+    pub annuli: usize,
+    pub superficial_velocity_m_s: f64,
+    #[serde(default)]
+    pub from_s: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub until_s: Option<f64>,
 }
 
 impl Default for Gas {
@@ -432,6 +450,7 @@ impl Default for Gas {
             cfl_factor: d_cfl(),
             acoustic_speed_factor: d_acoustic_speed_factor(),
             time_scheme: Default::default(),
+            inlet_jet: None,
         }
     }
 }

@@ -103,9 +103,14 @@ impl Case {
                     );
                 }
             }
-            // The Mach number of the solver's gas: its pressure waves travel at f·a.
+            // The Mach number of the solver's gas: its pressure waves travel at f·a; a jet's too.
             let (a, eps) = (g.acoustic_speed_m_s(), g.inlet_voidage);
-            if a.is_finite() && a > 0.0 && eps > 0.0 && u.is_finite() {
+            let jet =
+                g.inlet_jet.as_ref().map(|j| ("/gas/inlet_jet/superficial_velocity_m_s", j.superficial_velocity_m_s));
+            for (path, u) in std::iter::once(("/gas/superficial_velocity_m_s", u)).chain(jet) {
+                if !(a.is_finite() && a > 0.0 && eps > 0.0 && u.is_finite()) {
+                    continue;
+                }
                 let limit = MAX_INLET_MACH * a * eps;
                 if u / eps > MAX_INLET_MACH * a {
                     let raise = if g.acoustic_speed_factor < 1.0 {
@@ -114,7 +119,7 @@ impl Case {
                         ""
                     };
                     r.error(
-                        "/gas/superficial_velocity_m_s",
+                        path,
                         json_num(u),
                         format!(
                             "<= {limit:.2} m/s (inlet Mach number U/(ε_inlet·f·a) <= {MAX_INLET_MACH}, f·a = {a:.1} m/s{raise})"

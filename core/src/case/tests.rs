@@ -191,3 +191,23 @@ fn a_drag_held_longer_than_tested_warns_and_the_default_does_not() {
     frozen.dem.frozen = true;
     assert!(!warned(&frozen));
 }
+
+#[test]
+fn an_inlet_jet_outside_the_grid_or_its_window_or_the_mach_limit_is_named() {
+    let mut c = Case::parse_str(paper_case_json()).unwrap().0;
+    let jet =
+        |annuli, u, from, until| Some(InletJet { annuli, superficial_velocity_m_s: u, from_s: from, until_s: until });
+    c.gas = Some(Gas { inlet_jet: jet(1, 3.0, 0.1, Some(0.2)), ..Gas::default() });
+    assert!(c.validate().is_ok(), "{:?}", c.validate().errors);
+    // 0.022-m radius in annuli of 4.4 mm: 5 annuli.
+    c.gas = Some(Gas { inlet_jet: jet(6, 3.0, 0.2, Some(0.1)), ..Gas::default() });
+    let rep = c.validate();
+    let paths: Vec<&str> = rep.errors.iter().map(|p| p.path.as_str()).collect();
+    assert!(paths.contains(&"/gas/inlet_jet/annuli"), "{paths:?}");
+    assert!(paths.contains(&"/gas/inlet_jet/until_s"), "{paths:?}");
+    let annuli = rep.errors.iter().find(|p| p.path == "/gas/inlet_jet/annuli").unwrap();
+    assert!(annuli.allowed.contains("[1, 5]"), "{}", annuli.allowed);
+    c.gas = Some(Gas { inlet_jet: jet(1, 90.0, 0.0, None), ..Gas::default() });
+    let rep = c.validate();
+    assert!(rep.errors.iter().any(|p| p.path == "/gas/inlet_jet/superficial_velocity_m_s"), "{:?}", rep.errors);
+}

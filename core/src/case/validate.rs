@@ -404,6 +404,40 @@ impl Case {
         }
     }
 
+    /// `gas.inlet_jet`: whole inner annuli of the grid, a velocity in the bed's range, an ordered window.
+    fn validate_inlet_jet(&self, j: &super::InletJet, r: &mut ValidationReport) {
+        let (rad, dr) = (self.column.diameter_m / 2.0, self.grid.dr_m);
+        let annuli = if dr > 0.0 && rad > 0.0 { (rad / dr).round().max(1.0) as usize } else { 1 };
+        if j.annuli < 1 || j.annuli > annuli {
+            r.error(
+                "/gas/inlet_jet/annuli",
+                j.annuli,
+                format!("[1, {annuli}] (the grid's annuli of dr = {dr} m)"),
+                "jet annuli out of range",
+            );
+        }
+        r.range(
+            "/gas/inlet_jet/superficial_velocity_m_s",
+            j.superficial_velocity_m_s,
+            0.0,
+            false,
+            100.0,
+            false,
+            "jet superficial velocity",
+        );
+        r.range("/gas/inlet_jet/from_s", j.from_s, 0.0, false, 1e6, false, "jet start");
+        if let Some(until) = j.until_s {
+            if !(until.is_finite() && until > j.from_s) {
+                r.error(
+                    "/gas/inlet_jet/until_s",
+                    json_num(until),
+                    format!("> from_s = {}", j.from_s),
+                    "the jet must end after it starts",
+                );
+            }
+        }
+    }
+
     fn validate_gas(&self, g: &Gas, r: &mut ValidationReport) {
         r.range(
             "/gas/superficial_velocity_m_s",
@@ -487,6 +521,9 @@ impl Case {
         }
         if gr.n0 < 3 || gr.n0 > 64 {
             r.error("/grid/n0", gr.n0, "[3, 64]", "cells in the central annulus out of range");
+        }
+        if let Some(j) = &g.inlet_jet {
+            self.validate_inlet_jet(j, r);
         }
         let dz = self.grid_dz_m();
         if let Some(dz) = gr.dz_m {

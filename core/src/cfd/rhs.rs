@@ -28,6 +28,7 @@
 
 use super::boundary::ramped_superficial_velocity;
 use super::geometry::FaceGeometry;
+use super::inlet_jet::InletJet;
 use super::params::{GasParams, Outlet};
 
 /// Primitive fields computed from the state before each right-hand side.
@@ -115,13 +116,18 @@ pub struct RhsInput<'a> {
     /// (n values; the top layer's unused), then each layer's horizontal faces (nz × faces).
     pub face_flux: &'a [f64],
     pub time: f64,
+    /// A jet through the distributor's inner annuli (inlet_jet.rs), if the case has one.
+    pub jet: Option<InletJet>,
 }
 
 impl RhsInput<'_> {
-    /// Interstitial inlet velocity U(t)/ε_inlet and the inlet mass flux per area factor U(t).
-    pub(super) fn inlet(&self) -> (f64, f64) {
+    /// Interstitial inlet velocity U(t)/ε_inlet and the superficial inlet velocity U(t) of inlet
+    /// cell `c` (the bed's, or a jet's inside its window).
+    #[inline]
+    pub(super) fn inlet(&self, c: usize) -> (f64, f64) {
         let p = self.params;
-        let u = ramped_superficial_velocity(p.superficial_velocity, p.ramp_time, self.time);
+        let u_set = self.jet.map_or(p.superficial_velocity, |j| j.velocity(c, self.time, p.superficial_velocity));
+        let u = ramped_superficial_velocity(u_set, p.ramp_time, self.time);
         (u / p.inlet_voidage, u)
     }
     /// The horizontal-face corrections of layer k.
@@ -217,7 +223,7 @@ pub fn face_flux_rate(eps_f: f64, rho_f: f64, beta_f: f64, mismatch: f64, delta:
 #[inline]
 pub fn inlet_mass_flux(inp: &RhsInput, p: &[f64], i: usize) -> f64 {
     let (par, a2) = (inp.params, inp.params.sound_speed * inp.params.sound_speed);
-    let (_, u_in) = inp.inlet();
+    let (_, u_in) = inp.inlet(i);
     let rho_f = inlet_face_pressure(p[i], (inp.nz > 1).then(|| p[i + inp.per]), par.gravity, inp.dz, a2) / a2;
     rho_f * u_in * inp.geo.area_z
 }

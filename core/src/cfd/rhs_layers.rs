@@ -106,13 +106,13 @@ fn gradients_body(
         gx[b] += (dp - w) * f.sx;
         gy[b] += (dp - w) * f.sy;
     }
-    let (w_in, _) = inp.inlet();
     let (inv_v, az) = (1.0 / geo.volume, geo.area_z);
     let jz = |lo: f64, hi: f64| 0.5 * (lo + hi) * inp.dz;
     let below = (k > 0).then(|| (l(pr.uz, k - 1), l(pr.p, k - 1)));
     let above = (k + 1 < nz).then(|| (l(pr.uz, k + 1), l(pr.p, k + 1)));
     // Face values (w, p) below and above each cell.
-    let inlet = |c: usize| (w_in, inlet_face_pressure(p[c], above.map(|(_, pa)| pa[c]), par.gravity, inp.dz, a2));
+    let inlet =
+        |c: usize| (inp.inlet(c).0, inlet_face_pressure(p[c], above.map(|(_, pa)| pa[c]), par.gravity, inp.dz, a2));
     let top = |c: usize| {
         let p_below = below.map_or(p[c], |(_, pb)| pb[c]);
         let w = if par.outlet == Outlet::Wall { 0.0 } else { uz[c] };
@@ -316,8 +316,8 @@ fn residual_body(
     if k == 0 {
         // Inlet: ṁ = ρ_f·U(t)·A_z with the face density of the hydrostatic ghost, momentum
         // flux ṁ·U(t)/ε_in (vertical only), no viscous flux.
-        let (w_in, _) = inp.inlet();
         for (c, r) in out.iter_mut().enumerate() {
+            let (w_in, _) = inp.inlet(c);
             let m_in = inlet_mass_flux(inp, pr.p, c);
             r[0] += m_in * inv_v;
             r[3] += m_in * w_in * inv_v;

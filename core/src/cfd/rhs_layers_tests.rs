@@ -70,6 +70,7 @@ impl Fields {
             force: &self.force,
             face_flux: &self.face,
             time: 0.05,
+            jet: None,
         }
     }
     fn view(&self) -> PrimView<'_> {

@@ -6,6 +6,7 @@ use super::boundary::{outlet_layer, OutletGeometry};
 use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
 use super::implicit_drag::{self, ImplicitDrag};
+use super::inlet_jet::InletJet;
 use super::mass_budget::{MassBalance, MassBudget};
 use super::params::{GasParams, Outlet, TimeScheme};
 use super::rhs::{
@@ -93,6 +94,8 @@ pub struct GasSolver {
     scheme: TimeScheme,
     /// d(ρε)/dt of the forward–backward step's mass pass.
     mass_rate: Vec<f64>,
+    /// A jet through the distributor (`gas.inlet_jet`; set from the case, also on restore).
+    jet: Option<InletJet>,
 }
 
 /// What the face pressures of `pressure_gradient_cyl` read of a cell: p, β/ε² and εu (Cartesian).
@@ -140,6 +143,7 @@ impl GasSolver {
         };
         let mut s = GasSolver::from_state(st, grid);
         s.scheme = g.time_scheme;
+        s.set_inlet_jet(g.inlet_jet.as_ref());
         s.anchor_pressure(g.outlet_pressure_pa);
         for c in 0..n {
             let rho = s.hydrostatic_density(c);
@@ -174,6 +178,7 @@ impl GasSolver {
             // The checkpoint holds no scheme: the default until set (`Simulation::restore` sets the case's).
             scheme: TimeScheme::default(),
             mass_rate: vec![0.0; n],
+            jet: None,
             grid,
         }
     }
@@ -212,6 +217,11 @@ impl GasSolver {
     /// Recount the steps taken (`Simulation::set_gas_time_scheme`: the count of the new step's length).
     pub fn set_steps(&mut self, steps: u64) {
         self.st.steps = steps;
+    }
+    /// The jet through the distributor, from the case's `gas.inlet_jet` (a checkpoint's comes from
+    /// its case).
+    pub fn set_inlet_jet(&mut self, spec: Option<&crate::case::InletJet>) {
+        self.jet = spec.map(|j| InletJet::new(j, &self.grid));
     }
     /// The time scheme (a checkpoint's comes from its case).
     pub fn set_time_scheme(&mut self, scheme: TimeScheme) {
@@ -605,7 +615,7 @@ impl GasSolver {
         }
         combine(&mut self.st.face_flux, &self.face_old, &[&g_new], &[dt]);
         let (per, nz) = (self.grid.cells_per_layer(), self.grid.nz);
-        let inp = state_input(&self.st, &self.geo, &self.grid, t);
+        let inp = state_input(&self.st, &self.geo, &self.grid, t, self.jet);
         let pr = self.prim.view();
         for k in 0..nz - 1 {
             axial_mass_faces(&inp, &self.st.q, &pr, k, &mut self.axial[k * per..(k + 1) * per]);
@@ -645,6 +655,7 @@ impl GasSolver {
             force: &self.st.force,
             drag: implicit_drag_of(&self.st.drag_coef, &self.st.drag_u0),
             time: self.st.time,
+            jet: self.jet,
             dt,
             weights,
             forward_backward,
@@ -735,7 +746,7 @@ impl GasSolver {
 
     /// ṁ_in − ṁ_out of the right-hand side just computed (its primitives and axial faces).
     fn net_inflow(&self, t: f64) -> f64 {
-        let inp = state_input(&self.st, &self.geo, &self.grid, t);
+        let inp = state_input(&self.st, &self.geo, &self.grid, t, self.jet);
         net_mass_inflow(&inp, &self.prim.p, &self.axial)
     }
 
@@ -782,7 +793,7 @@ impl GasSolver {
         let per = self.grid.cells_per_layer();
         let nz = self.grid.nz;
         let nf = self.geo.faces.len().max(1);
-        let inp = state_input(&self.st, &self.geo, &self.grid, t);
+        let inp = state_input(&self.st, &self.geo, &self.grid, t, self.jet);
         let q = &self.st.q;
         let pr = &mut self.prim;
         // Layers per task: all of them on one thread below the parallel size, else one block per thread.
@@ -842,7 +853,13 @@ fn implicit_drag_of<'a>(coef: &'a [f64], u0: &'a [[f64; 3]]) -> Option<ImplicitD
 }
 
 /// What the right-hand side reads besides the cells' state, at time t.
-fn state_input<'a>(st: &'a State, geo: &'a FaceGeometry, grid: &CylGrid, t: f64) -> RhsInput<'a> {
+fn state_input<'a>(
+    st: &'a State,
+    geo: &'a FaceGeometry,
+    grid: &CylGrid,
+    t: f64,
+    jet: Option<InletJet>,
+) -> RhsInput<'a> {
     RhsInput {
         geo,
         params: &st.params,
@@ -853,6 +870,7 @@ fn state_input<'a>(st: &'a State, geo: &'a FaceGeometry, grid: &CylGrid, t: f64)
         force: &st.force,
         face_flux: &st.face_flux,
         time: t,
+        jet,
     }
 }
 

@@ -12,6 +12,7 @@ use super::boundary::{outlet_layer, OutletGeometry};
 use super::forward_backward::{add_pressure_force, axial_mass_faces, mass_layer, without_pressure_force};
 use super::geometry::FaceGeometry;
 use super::implicit_drag::{self, ImplicitDrag};
+use super::inlet_jet::InletJet;
 use super::params::{GasParams, Outlet};
 use super::rhs::{PrimView, Primitives, RhsInput};
 use super::rhs_layers::{axial_layer, gradients_layer, primitives_layer, residual_layer};
@@ -28,6 +29,7 @@ pub(super) struct StepInput<'a> {
     /// The drag on the gas stepped implicitly after the momentum's other terms (implicit_drag.rs).
     pub drag: Option<ImplicitDrag<'a>>,
     pub time: f64,
+    pub jet: Option<InletJet>,
     pub dt: f64,
     /// The AB weights times the step: of the new right-hand side, then of `past` (one or two).
     /// With `forward_backward` they step the momentum's terms other than the pressure force.
@@ -226,6 +228,7 @@ fn rhs_input<'a>(inp: &StepInput<'a>, face_flux: &'a [f64]) -> RhsInput<'a> {
         force: inp.force,
         face_flux,
         time: inp.time,
+        jet: inp.jet,
     }
 }
 

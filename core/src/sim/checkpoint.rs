@@ -135,6 +135,7 @@ pub(super) fn decode(bytes: &[u8]) -> Result<State, String> {
     // The gas's time scheme is the case's (the gas section holds its state only).
     if let (Some(g), Some(gc)) = (gas.as_mut(), case.gas.as_ref()) {
         g.set_time_scheme(gc.time_scheme);
+        g.set_inlet_jet(gc.inlet_jet.as_ref());
     }
     // A checkpoint from before the gas mass budget starts it afresh at the resumed state.
     if let Some(body) = sections.get("gas_mass_budget") {

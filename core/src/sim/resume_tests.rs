@@ -79,6 +79,15 @@ fn resume_with_the_gas_stepped_forward_backward_is_bit_identical() {
 }
 
 #[test]
+fn resume_inside_an_inlet_jets_window_is_bit_identical() {
+    // The checkpoint's gas holds no jet: the resumed gas takes it from the checkpoint's case.
+    let mut c = case();
+    c.gas.as_mut().unwrap().inlet_jet =
+        Some(crate::case::InletJet { annuli: 1, superficial_velocity_m_s: 3.0, from_s: 0.001, until_s: Some(0.003) });
+    resume_is_bit_identical(c);
+}
+
+#[test]
 fn resume_with_the_drag_on_the_gas_implicit_is_bit_identical() {
     // The cut falls between couplings: the gas's drag coefficients and the coupling's gas
     // velocity are part of its state (cfd/implicit_drag.rs), on both gas schemes.

@@ -5,6 +5,7 @@ mod conservation;
 mod forward_backward;
 mod freeboard;
 mod hydrostatic;
+mod lateral_redistribution;
 mod layer_pressure;
 mod mass_budget;
 mod outlet_pressure;
