@@ -7,9 +7,8 @@
 //! faces' fluxes and pressure forces of the equal-volume grid. A jet through the inner annuli
 //! into a uniform zone spreads to the area-weighted mean velocity in every cell.
 
-use super::support::solver;
+use super::support::{beetstra_f, fixed_bed_gas, solver, step_through_fixed_bed};
 use crate::case::Gas;
-use crate::coupling::beetstra_f;
 
 const MU: f64 = 1.8e-5;
 const D: f64 = 1.2e-3;
@@ -52,15 +51,7 @@ fn redistributed_with(
 ) -> ([f64; 2], [f64; 2]) {
     let u0 = 0.2;
     let (nz, dz) = (60, 0.0025);
-    let gas = Gas {
-        inlet_jet: inlet_jet.clone(),
-        superficial_velocity_m_s: u0,
-        ramp_time_s: 2e-3,
-        inlet_voidage: 1.0,
-        viscosity_pa_s: MU,
-        outlet_relaxation: 0.25,
-        ..Default::default()
-    };
+    let gas = Gas { inlet_jet: inlet_jet.clone(), ..fixed_bed_gas(u0, MU) };
     // D = 30 mm, 3 annuli of 3, 9 and 15 cells; no gravity: the drop is the resistance alone.
     let mut s = solver(gas, 0.0, 3, 0.005, nz, dz);
     let (per, grid) = (s.grid().cells_per_layer(), s.grid().clone());
@@ -72,14 +63,7 @@ fn redistributed_with(
     s.set_initial_voidage(&eps);
     let dt = s.stable_dt();
     for _ in 0..20_000 {
-        for (c, &e) in eps.iter().enumerate() {
-            let (rho, u) = (s.density(c), s.velocity_cyl(c));
-            let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-            let beta = 18.0 * MU * e * (1.0 - e) * beetstra_f(e, rho * e * speed * D / MU) / (D * D);
-            s.interaction_force_mut()[c] = [-beta * u[0], -beta * u[1], -beta * u[2]];
-        }
-        s.step(dt);
-        s.check_finite().unwrap_or_else(|e| panic!("{e}"));
+        step_through_fixed_bed(&mut s, &eps, D, MU, dt);
     }
     // Superficial velocity of each part: its mass flux over the inflow's density, layers 25–35
     // (40 mm from either end of the zone).

@@ -2,20 +2,7 @@
 //! (PHYSICS.md 1.1, 11): at steady state −ε∇p + I = 0, I = −β_A u, β_A = 18μεφF/d², u = U0/ε, so
 //! −dp/dz = 18 μ φ F(ε, Re) U0 / (ε d²), Re = ρ U0 d/μ.
 
-use super::support::{layer_mean, solver};
-use crate::case::Gas;
-
-/// Beetstra, van der Hoef & Kuipers (2007) F = F0 + F1 (PHYSICS.md 1.1).
-fn beetstra_f(eps: f64, re: f64) -> f64 {
-    let phi = 1.0 - eps;
-    let f0 = 10.0 * phi / (eps * eps) + eps * eps * (1.0 + 1.5 * phi.sqrt());
-    if re <= 0.0 {
-        return f0;
-    }
-    let f1 = 0.413 * re / (24.0 * eps * eps) * (1.0 / eps + 3.0 * eps * phi + 8.4 * re.powf(-0.343))
-        / (1.0 + 10f64.powf(3.0 * phi) * re.powf(-(1.0 + 4.0 * phi) / 2.0));
-    f0 + f1
-}
+use super::support::{beetstra_f, fixed_bed_gas, layer_mean, solver, step_through_fixed_bed};
 
 #[test]
 fn beetstra_helper_reproduces_the_physics_table() {
@@ -29,15 +16,7 @@ fn porous_zone_pressure_drop_matches_model_a_beetstra() {
     let (u0, d, mu) = (0.2, 1.2e-3, 1.8e-5);
     let (nz, dz) = (40, 0.0025);
     // No gravity (Δp is the resistance alone); the zone starts above the inlet, so ε_in = 1.
-    let gas = Gas {
-        superficial_velocity_m_s: u0,
-        ramp_time_s: 2e-3,
-        inlet_voidage: 1.0,
-        viscosity_pa_s: mu,
-        outlet_relaxation: 0.25,
-        ..Default::default()
-    };
-    let mut s = solver(gas, 0.0, 1, 0.005, nz, dz);
+    let mut s = solver(fixed_bed_gas(u0, mu), 0.0, 1, 0.005, nz, dz);
     let per = s.grid().cells_per_layer();
     let (k_lo, k_hi) = (12, 28); // ε = 0.4 in layers [12, 28): z from 0.03 to 0.07 m
     let eps: Vec<f64> =
@@ -45,17 +24,7 @@ fn porous_zone_pressure_drop_matches_model_a_beetstra() {
     s.set_initial_voidage(&eps);
     let dt = s.stable_dt();
     for _ in 0..12_000 {
-        // Particles at rest: I = −β_A u, β_A = 18μεφF(ε, Re)/d², Re = ρε|u|d/μ.
-        for (c, &e) in eps.iter().enumerate() {
-            let (rho, u) = (s.density(c), s.velocity_cyl(c));
-            let speed = (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt();
-            let beta = 18.0 * mu * e * (1.0 - e) * beetstra_f(e, rho * e * speed * d / mu) / (d * d);
-            s.interaction_force_mut()[c] = [-beta * u[0], -beta * u[1], -beta * u[2]];
-        }
-        s.step(dt);
-        if let Err(e) = s.check_finite() {
-            panic!("{e}");
-        }
+        step_through_fixed_bed(&mut s, &eps, d, mu, dt);
     }
     let p = |k: usize| layer_mean(&s, k, |c| s.pressure()[c]);
     // The collocated central scheme leaves an odd–even ripple in p downstream of the ε jumps
