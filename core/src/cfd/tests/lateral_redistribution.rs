@@ -38,13 +38,10 @@ fn analytic(parts: &[(f64, f64)], u0: f64, rho: f64) -> Vec<f64> {
     parts.iter().map(|&(_, e)| part_velocity(0.5 * (lo + hi), e, rho)).collect()
 }
 
-/// Runs the zone with ε = `eps[part]` for the cells `part_of` puts in part 0 or 1 and returns the
-/// measured and analytic superficial velocities of both parts in the middle of the zone.
-fn redistributed(eps_parts: [f64; 2], part_of: impl Fn(&crate::grid::CylGrid, usize) -> usize) -> ([f64; 2], [f64; 2]) {
-    redistributed_with(eps_parts, part_of, None)
-}
-
-fn redistributed_with(
+/// Runs the zone with ε = `eps[part]` for the cells `part_of` puts in part 0 or 1 (and the inlet
+/// jet, if any) and returns the measured and analytic superficial velocities of both parts in the
+/// middle of the zone.
+fn redistributed(
     eps_parts: [f64; 2],
     part_of: impl Fn(&crate::grid::CylGrid, usize) -> usize,
     inlet_jet: Option<crate::case::InletJet>,
@@ -82,7 +79,7 @@ fn redistributed_with(
     let w = n[0] / (n[0] + n[1]);
     // A jet raises the mean inflow by its cells' share of the inlet.
     let u0 = inlet_jet.as_ref().map_or(u0, |j| {
-        let jet: usize = (0..j.annuli).map(|i| grid.cells_in_annulus(i)).sum();
+        let jet = crate::cfd::InletJet::new(j, &grid).cells;
         u0 + (j.superficial_velocity_m_s - u0) * jet as f64 / per as f64
     });
     let want = analytic(&[(w, eps_parts[0]), (1.0 - w, eps_parts[1])], u0, rho_mean);
@@ -104,14 +101,14 @@ fn assert_close(label: &str, (got, want): ([f64; 2], [f64; 2])) {
 #[test]
 fn gas_redistributes_radially_to_the_looser_outer_annulus() {
     // Inner two annuli (12 cells) ε = 0.4, outer annulus (15 cells) ε = 0.6.
-    let r = redistributed([0.4, 0.6], |g, c| usize::from(c >= g.cells_in_annulus(0) + g.cells_in_annulus(1)));
+    let r = redistributed([0.4, 0.6], |g, c| usize::from(c >= g.cells_in_annulus(0) + g.cells_in_annulus(1)), None);
     assert_close("radial split", r);
 }
 
 #[test]
 fn gas_redistributes_across_angles_to_the_looser_half() {
     // Cells whose centre has x > 0 at ε = 0.4, the others at ε = 0.6.
-    let r = redistributed([0.4, 0.6], |g, c| usize::from(g.centre_xyz(c)[0] <= 0.0));
+    let r = redistributed([0.4, 0.6], |g, c| usize::from(g.centre_xyz(c)[0] <= 0.0), None);
     assert_close("angular split", r);
 }
 
@@ -120,7 +117,7 @@ fn a_jet_through_the_inner_annulus_spreads_to_the_mean_velocity() {
     // ε = 0.4 everywhere in the zone; the central annulus (3 of 27 inlet cells) blows 2 m/s, the
     // rest 0.2 m/s: 40 mm into the zone every cell carries the mean, 0.4 m/s.
     let jet = crate::case::InletJet { annuli: 1, superficial_velocity_m_s: 2.0, from_s: 0.0, until_s: None };
-    let r = redistributed_with([0.4, 0.4], |g, c| usize::from(c >= g.cells_in_annulus(0)), Some(jet));
+    let r = redistributed([0.4, 0.4], |g, c| usize::from(c >= g.cells_in_annulus(0)), Some(jet));
     assert!((r.1[0] - 0.4).abs() < 1e-9, "mean inflow {}", r.1[0]);
     assert_close("jet", r);
 }
