@@ -88,19 +88,20 @@ async fn a_job_that_took_the_server_down_twice_is_not_resumed_a_third_time() {
     let http = reqwest::Client::new();
     let dir = TempDir::new("crashes");
     let case = lattice_case(4, 2, 50.0, 0.01);
-    let (mut loc, mut last_steps) = (String::new(), 0);
+    let mut loc = String::new();
     for round in 0..2 {
         let s = start(dir.path(), None);
         if round == 0 {
             loc = submit(&http, &s.url(), &case).await;
         }
         let url = format!("{}{loc}", s.url());
-        // Past the steps stored by the last server: this server has taken the job up (and counted
-        // the restart) before it is killed.
-        let j =
-            wait_until(&http, &url, Duration::from_secs(60), |j| j["steps"].as_u64().unwrap_or(0) > last_steps).await;
+        // Past the steps stored when this server came up (the killed one wrote progress up to its
+        // end, after the last read of the previous round): this server has taken the job up (and
+        // counted the restart) before it is killed.
+        let stored: Value = http.get(&url).send().await.unwrap().json().await.unwrap();
+        let before = stored["steps"].as_u64().unwrap_or(0);
+        let j = wait_until(&http, &url, Duration::from_secs(60), |j| j["steps"].as_u64().unwrap_or(0) > before).await;
         assert_eq!(status(&j), "running", "round {round}: {j}");
-        last_steps = j["steps"].as_u64().unwrap();
         s.kill();
     }
     let s = start(dir.path(), None);
