@@ -12,7 +12,8 @@
 //! the fluid layer height over the radial spacing, and `sublayers`, the case's
 //! `coupling.drag_voidage_sublayers`, and `pressure_gas_step` or `pressure_mean`, 1 for the
 //! case's `coupling.pressure_force` "gas_step" or "interval_mean", 0 for the case's own, and
-//! `interval`, the case's `coupling.interval_steps`).
+//! `interval`, the case's `coupling.interval_steps`, and `density`, the particles' density, the
+//! DEM step scaled with it as the Hertz contact time, ρ^(2/5)).
 //! `umf-paper-cells` runs the same sweep with dz = dr, the drag voidage on 8 sub-layers per cell
 //! and the pressure force following the gas.
 
@@ -39,6 +40,9 @@ struct Sweep {
     ab3: bool,
     /// `coupling.interval_steps` (None: the case's).
     interval: Option<u32>,
+    /// The particles' density (kg/m³; None: the case's), the DEM step scaled with the Hertz
+    /// contact time, which goes as ρ^(2/5).
+    density: Option<f64>,
     /// The gas's voidage and the drag on it held between couplings (`coupling.gas_voidage` and
     /// `gas_drag` "held"; else the case's).
     gas_held: bool,
@@ -60,6 +64,7 @@ impl Sweep {
             pressure_force: None,
             ab3: false,
             interval: None,
+            density: None,
             gas_held: false,
         }
     }
@@ -84,7 +89,8 @@ impl Sweep {
                 "pressure_mean" => s.pressure_force = (x != 0.0).then_some(PressureForce::IntervalMean),
                 "ab3" => s.ab3 = x != 0.0,
                 "interval" => s.interval = Some(x as u32),
-                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, ab3, interval)"),
+                "density" => s.density = Some(x),
+                _ => panic!("FLUIDBED_UMF: unknown key '{k}' (column_mm, height_mm, seed, start, step, stages, hold, dz_over_dr, sublayers, pressure_gas_step, pressure_mean, ab3, interval, density)"),
             }
         }
         s
@@ -137,6 +143,10 @@ fn sweep(sw: Sweep, name: &str, docs_png: &str) -> serde_json::Value {
     }
     if sw.ab3 {
         case.gas.as_mut().expect("gas").time_scheme = fluidbed_core::cfd::TimeScheme::Ab3;
+    }
+    if let Some(rho) = sw.density {
+        case.dem.time_step_s *= (rho / case.particles.density_kg_m3).powf(0.4);
+        case.particles.density_kg_m3 = rho;
     }
     let dz = sw.dz_over_dr * case.grid.dr_m;
     case.grid.dz_m = Some(dz);
