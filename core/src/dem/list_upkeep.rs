@@ -2,36 +2,26 @@
 //! Verlet list, the Verlet list rebuilt (with a re-sort by cell and the contact histories
 //! carried by particle id) when a particle could have moved past its skin (`near_list`).
 
-use super::contact::{dist2, V3};
+use super::contact::V3;
+use super::id_histories::IdHistories;
 use super::near_list::Histories;
 use super::neighbors::{build_list, cell_order};
 use super::system::DemSystem;
 use super::walls::WallList;
-use rayon::prelude::*;
 
 impl DemSystem {
     /// Redraw the near list from the Verlet list, rebuilding that first if a particle has moved
     /// far enough since its build that it might miss a pair closer than d + near gap.
     pub(super) fn refresh(&mut self) {
         let reach = self.p.outer_move();
-        let moved = self.x.iter().zip(&self.x_build).any(|(&a, &b)| dist2(a, b) > reach * reach);
-        if moved {
+        if self.x_build.any_beyond(&self.x, reach) {
             self.rebuild_due = true;
             return;
         }
-        let (spare, code) = &mut self.spare;
-        spare.select_into(
-            &self.outer,
-            &self.x,
-            2.0 * self.p.radius,
-            self.p.near_gap(),
-            Histories::Near(&self.near),
-            code,
-        );
-        std::mem::swap(&mut self.near, spare);
+        self.near.refresh(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), &mut self.near_codes);
         self.sc.bounds.clear(); // replanned for the new list at the next step
-        self.x_near.clone_from(&self.x);
-        self.moved_bound = 0.0;
+        self.x_near.store(&self.x);
+        self.moved_bound = self.x_near.err; // a bound on the measured distance too
         self.builds.1 += 1;
     }
 
@@ -43,7 +33,7 @@ impl DemSystem {
 
     /// The largest squared displacement since the last refresh (as the particle pass measures it).
     pub(super) fn largest_disp2(&self) -> f64 {
-        self.x.par_iter().zip(&self.x_near).map(|(&a, &b)| dist2(a, b)).reduce(|| 0.0, f64::max)
+        self.x_near.largest_disp2(&self.x)
     }
 
     /// Re-sort particles by linked cell, rebuild the Verlet list, carry contact history by id,
@@ -61,21 +51,20 @@ impl DemSystem {
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
         let diameter = 2.0 * self.p.radius;
-        let mut nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
-        if self.p.friction {
-            nl.carry_history(&self.near.list, &old_ids, &self.ids);
-        }
-        let (spare, code) = &mut self.spare;
-        spare.select_into(&nl, &self.x, diameter, self.p.near_gap(), Histories::Outer, code);
-        std::mem::swap(&mut self.near, spare);
-        (nl.shear, nl.touch) = (Vec::new(), Vec::new());
+        self.outer = Default::default(); // the old list is not read again
+        let nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
+        let carried = if self.p.friction { IdHistories::of(&self.near.list, &old_ids) } else { Default::default() };
+        // The old near list's storage takes the new one (its histories are carried by now).
+        let code = &mut self.near_codes;
+        let hist = Histories::Carried(&carried, &self.ids);
+        self.near.select_into(&nl, &self.x, diameter, self.p.near_gap(), hist, code);
         self.outer = nl;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc.bounds.clear(); // replanned for the new list at the next step
-        self.x_build.clone_from(&self.x);
-        self.x_near.clone_from(&self.x);
-        self.moved_bound = 0.0;
+        self.x_build.store(&self.x);
+        self.x_near.store(&self.x);
+        self.moved_bound = self.x_near.err; // a bound on the measured distance too
         self.rebuild_due = false;
         self.builds.0 += 1;
     }

@@ -14,6 +14,7 @@
 //! sums may group differently and differ in rounding).
 
 use super::contact::V3;
+use super::id_histories::IdHistories;
 use super::neighbors::NeighborList;
 use crate::buffers::resize_reused;
 use rayon::prelude::*;
@@ -49,16 +50,19 @@ impl<'de> serde::Deserialize<'de> for Retired {
 
 /// A selection code: the list entry is left out, kept (with the list's history, if any), or
 /// kept with the history of the old near entry of the same partner.
-const SKIP: u8 = 0;
-const TAKE: u8 = 1;
-const TAKE_OLD: u8 = 2;
+pub(super) const SKIP: u8 = 0;
+pub(super) const TAKE: u8 = 1;
+pub(super) const TAKE_OLD: u8 = 2;
 
 /// Where the contact histories of a selection come from.
 #[derive(Clone, Copy)]
 pub enum Histories<'a> {
-    /// The Verlet list's own (`shear`, `touch`; right after a build, carried by id).
-    Outer,
-    /// The near list drawn from the same Verlet list before (matched by entry).
+    /// The live histories of the near list before a re-sort, by particle id (`ids`: the id of
+    /// each row now).
+    Carried(&'a IdHistories, &'a [u32]),
+    /// The near list drawn from the same Verlet list before (matched by entry); runs refresh
+    /// in place instead (`near_refresh`), tested against this.
+    #[cfg_attr(not(test), allow(dead_code))]
     Near(&'a NearList),
 }
 
@@ -92,53 +96,18 @@ impl NearList {
         assert!(x.len() == n, "one position per list row");
         assert!(outer.offsets.last().is_none_or(|&o| o as usize == total_in), "list offsets");
         let empty = NearList::default();
-        let old = match hist {
+        let (old, carried) = match hist {
             Histories::Near(old) => {
                 assert!(old.list.offsets.len() == n + 1, "near list of another list");
-                old
+                (old, None)
             }
-            Histories::Outer => {
-                assert!(outer.shear.len() == total_in && outer.touch.len() == total_in, "list histories");
-                &empty
+            Histories::Carried(h, ids) => {
+                assert!(ids.len() == n, "one id per list row");
+                (&empty, Some((h, ids)))
             }
         };
         let from_old = matches!(hist, Histories::Near(_));
-        let reach2 = (diameter + gap) * (diameter + gap);
-        code.clear();
-        resize_reused(code, total_in, 0);
-        let mut counts = vec![0u32; n];
-        let blocks: Vec<_> = (0..n.div_ceil(BLOCK)).map(|b| b * BLOCK..((b + 1) * BLOCK).min(n)).collect();
-        let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
-        // Sweep 1: codes and counts, block by block.
-        let mut work = Vec::with_capacity(blocks.len());
-        let (mut crest, mut nrest) = (&mut code[..], &mut counts[..]);
-        for r in &blocks {
-            let (c0, c1) = std::mem::take(&mut crest).split_at_mut(entries(r).len());
-            let (n0, n1) = std::mem::take(&mut nrest).split_at_mut(r.len());
-            (crest, nrest) = (c1, n1);
-            work.push((r.clone(), c0, n0));
-        }
-        work.into_par_iter().for_each(|(r, codes, cnt)| {
-            let base = outer.offsets[r.start] as usize;
-            for i in r.clone() {
-                let xi = x[i];
-                // Cursor over the old near row i, a subsequence of the list row.
-                let (mut p, p_end) =
-                    if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
-                for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
-                    let matched = p < p_end && old.list.nbr[p] == outer.nbr[k];
-                    let live = if from_old { matched && old.list.touch[p] != 0 } else { outer.touch[k] != 0 };
-                    let xj = x[outer.nbr[k] as usize];
-                    let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
-                    let take = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach2 || live;
-                    let c = if matched { TAKE_OLD } else { TAKE };
-                    codes[k - base] = if take { c } else { SKIP };
-                    cnt[i - r.start] += take as u32;
-                    p += matched as usize;
-                }
-                assert!(p == p_end, "old near row {i} is not a subsequence of the list row");
-            }
-        });
+        let counts = select_codes(outer, x, diameter, gap, hist, code);
         // Offsets, then sweep 2: each block's kept entries copied into its part of the storage.
         let l = &mut self.list;
         l.offsets.clear();
@@ -151,6 +120,7 @@ impl NearList {
         resize_reused(&mut l.shear, total, [0.0; 3]);
         resize_reused(&mut l.touch, total, 0);
         let offsets = &l.offsets;
+        let blocks = blocks_of(n);
         let mut work = Vec::with_capacity(blocks.len());
         let (mut j, mut h, mut t) = (&mut l.nbr[..], &mut l.shear[..], &mut l.touch[..]);
         for r in blocks {
@@ -172,9 +142,11 @@ impl NearList {
                 for (k, &c) in row.clone().zip(&code[row]) {
                     let matched = p < p_end && old.list.nbr[p] == outer.nbr[k];
                     if c != SKIP {
-                        let (sh, to) = match (c, from_old) {
-                            (TAKE, false) => (outer.shear[k], outer.touch[k]),
-                            (TAKE, true) => ([0.0; 3], 0),
+                        let (sh, to) = match (c, carried) {
+                            (TAKE, Some((h, ids))) => {
+                                h.get(ids[i], ids[outer.nbr[k] as usize]).map_or(([0.0; 3], 0), |s| (s, 1))
+                            }
+                            (TAKE, None) => ([0.0; 3], 0),
                             _ => (old.list.shear[p], old.list.touch[p]),
                         };
                         (nbr[e], shear[e], touch[e]) = (outer.nbr[k], sh, to);
@@ -185,4 +157,69 @@ impl NearList {
             }
         });
     }
+}
+
+/// The row blocks of a selection's sweeps.
+pub(super) fn blocks_of(n: usize) -> Vec<std::ops::Range<usize>> {
+    (0..n.div_ceil(BLOCK)).map(|b| b * BLOCK..((b + 1) * BLOCK).min(n)).collect()
+}
+
+/// Sweep 1 of a selection, in parallel blocks: a code per entry of `outer` into `code` (`SKIP`,
+/// `TAKE`, or `TAKE_OLD` where the old near list of `hist` has the entry), and the kept entries
+/// of each row. Reads the old near list only.
+pub(super) fn select_codes(
+    outer: &NeighborList,
+    x: &[V3],
+    diameter: f64,
+    gap: f64,
+    hist: Histories,
+    code: &mut Vec<u8>,
+) -> Vec<u32> {
+    let (old, carried) = match hist {
+        Histories::Near(old) => (Some(old), None),
+        Histories::Carried(h, ids) => (None, Some((h, ids))),
+    };
+    let n = outer.offsets.len().saturating_sub(1);
+    let reach2 = (diameter + gap) * (diameter + gap);
+    code.clear();
+    resize_reused(code, outer.nbr.len(), 0);
+    let mut counts = vec![0u32; n];
+    let blocks = blocks_of(n);
+    let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
+    let mut work = Vec::with_capacity(blocks.len());
+    let (mut crest, mut nrest) = (&mut code[..], &mut counts[..]);
+    for r in &blocks {
+        let (c0, c1) = std::mem::take(&mut crest).split_at_mut(entries(r).len());
+        let (n0, n1) = std::mem::take(&mut nrest).split_at_mut(r.len());
+        (crest, nrest) = (c1, n1);
+        work.push((r.clone(), c0, n0));
+    }
+    work.into_par_iter().for_each(|(r, codes, cnt)| {
+        let base = outer.offsets[r.start] as usize;
+        for i in r.clone() {
+            let xi = x[i];
+            // Cursor over the old near row i, a subsequence of the list row.
+            let (mut p, p_end) = match old {
+                Some(old) => (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize),
+                None => (0, 0),
+            };
+            for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
+                let matched = p < p_end && old.is_some_and(|o| o.list.nbr[p] == outer.nbr[k]);
+                let live = match (old, carried) {
+                    (Some(o), _) => matched && o.list.touch[p] != 0,
+                    (None, Some((h, ids))) => h.get(ids[i], ids[outer.nbr[k] as usize]).is_some(),
+                    (None, None) => false,
+                };
+                let xj = x[outer.nbr[k] as usize];
+                let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+                let take = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach2 || live;
+                let c = if matched { TAKE_OLD } else { TAKE };
+                codes[k - base] = if take { c } else { SKIP };
+                cnt[i - r.start] += take as u32;
+                p += matched as usize;
+            }
+            assert!(p == p_end, "old near row {i} is not a subsequence of the list row");
+        }
+    });
+    counts
 }

@@ -1,7 +1,7 @@
 //! O(N) neighbour search: linked cells give the cell order (particles are re-sorted by cell
 //! at every rebuild for memory locality) and a half Verlet list (each pair once, j > i) in CSR
-//! form, each row nearest first (touching pairs lead). At a build the tangential contact
-//! histories are carried into it by particle-id pair, then handed to the near list (`near_list`),
+//! form, each row nearest first (touching pairs lead). The list holds no contact histories: at a
+//! build they are carried by particle-id pair (`id_histories`) into the near list (`near_list`),
 //! which holds them between builds. Everything here is deterministic and independent of the thread count.
 
 use rayon::prelude::*;
@@ -160,54 +160,5 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
         }
         nbr.extend_from_slice(&list);
     }
-    NeighborList { offsets, nbr, shear: vec![[0.0; 3]; total], touch: vec![0; total] }
-}
-
-impl NeighborList {
-    /// Carry the non-zero contact history of `old` (whose particles had ids `old_ids`) into this
-    /// list (particles with ids `new_ids`), matched by id pair; orientation flips change the sign.
-    pub fn carry_history(&mut self, old: &NeighborList, old_ids: &[u32], new_ids: &[u32]) {
-        let n = new_ids.len();
-        if old.offsets.len() != old_ids.len() + 1 {
-            return; // no previous list (first build)
-        }
-        // Map keyed by the smaller id: CSR over ids of (larger id, ξ oriented small → large).
-        let mut count = vec![0u32; n + 1];
-        let mut entries = Vec::new();
-        for i in 0..old_ids.len() {
-            for k in old.offsets[i] as usize..old.offsets[i + 1] as usize {
-                let s = old.shear[k];
-                if old.touch[k] == 0 {
-                    continue;
-                }
-                let (a, b) = (old_ids[i], old_ids[old.nbr[k] as usize]);
-                let (lo, hi, s) = if a < b { (a, b, s) } else { (b, a, [-s[0], -s[1], -s[2]]) };
-                count[lo as usize + 1] += 1;
-                entries.push((lo, hi, s));
-            }
-        }
-        if entries.is_empty() {
-            return;
-        }
-        for i in 0..n {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut map = vec![(0u32, [0.0; 3]); entries.len()];
-        for (lo, hi, s) in entries {
-            map[fill[lo as usize] as usize] = (hi, s);
-            fill[lo as usize] += 1;
-        }
-        for i in 0..n {
-            for k in self.offsets[i] as usize..self.offsets[i + 1] as usize {
-                let (a, b) = (new_ids[i], new_ids[self.nbr[k] as usize]);
-                let (lo, hi, sign) = if a < b { (a, b, 1.0f32) } else { (b, a, -1.0) };
-                let row = &map[count[lo as usize] as usize..count[lo as usize + 1] as usize];
-                if let Some(&(_, s)) = row.iter().find(|e| e.0 == hi) {
-                    self.shear[k] = [sign * s[0], sign * s[1], sign * s[2]];
-                    self.touch[k] = 1;
-                }
-            }
-        }
-    }
+    NeighborList { offsets, nbr, shear: Vec::new(), touch: Vec::new() }
 }

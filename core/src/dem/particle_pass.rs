@@ -7,6 +7,7 @@ use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::{dist2, V3};
 use super::forces::{narrow, Acc, Past, PastV3, Stats};
 use super::kernel::{Isa, Kernel};
+use super::reference::{widen, RefV3};
 use super::walls::{wall_forces, WallList};
 use super::work_split::Sums;
 use super::DemParams;
@@ -155,7 +156,7 @@ pub(crate) struct Motion<'a> {
     pub past: &'a mut Past,
     /// Positions the largest displacement is measured from (the last near-list refresh);
     /// empty: not measured this step.
-    pub x_ref: &'a [V3],
+    pub x_ref: &'a [RefV3],
     pub walls: &'a mut WallList,
 }
 
@@ -217,7 +218,7 @@ pub(crate) fn update_block_on<const FR: bool>(
     p: &DemParams,
     step: Weights,
     bm: BlockMotion,
-    x_ref: &[V3],
+    x_ref: &[RefV3],
     ext: &[V3],
     sc: Sums,
 ) -> Stats {
@@ -251,7 +252,7 @@ unsafe fn update_block_avx512<const FR: bool>(
     p: &DemParams,
     step: Weights,
     bm: BlockMotion,
-    refs: (&[V3], &[V3]),
+    refs: (&[RefV3], &[V3]),
     sc: Sums,
 ) -> Stats {
     update_block::<FR, true>(isa, p, step, bm, refs, sc)
@@ -265,7 +266,7 @@ unsafe fn update_block_avx2<const FR: bool>(
     p: &DemParams,
     step: Weights,
     bm: BlockMotion,
-    refs: (&[V3], &[V3]),
+    refs: (&[RefV3], &[V3]),
     sc: Sums,
 ) -> Stats {
     update_block::<FR, false>(Isa::PORTABLE, p, step, bm, refs, sc)
@@ -279,7 +280,7 @@ fn update_block<const FR: bool, const V: bool>(
     p: &DemParams,
     Weights { hb, .. }: Weights,
     bm: BlockMotion,
-    (x_ref, ext): (&[V3], &[V3]),
+    (x_ref, ext): (&[RefV3], &[V3]),
     sc: Sums,
 ) -> Stats {
     let BlockMotion { lo, x, v, w, newer, older, widx, whist } = bm;
@@ -306,8 +307,8 @@ fn update_block<const FR: bool, const V: bool>(
     // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).
     let mut part = [0.0f64; 8];
-    for (l, (&xn, &xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
-        let d2 = dist2(xn, xb);
+    for (l, (&xn, xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
+        let d2 = dist2(xn, widen(xb));
         part[l % 8] = if d2 > part[l % 8] { d2 } else { part[l % 8] };
     }
     st.disp2 = part.iter().fold(st.disp2, |a, &b| if b > a { b } else { a });

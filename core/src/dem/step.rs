@@ -41,12 +41,11 @@ impl DemSystem {
             self.sc_threads = chunks;
         }
         let limit = self.p.near_move();
-        let refresh_disp2 = limit * limit;
         // Measure exactly when the bound, grown by twice the last step's move, could pass the
         // limit; a step whose move exceeds that is measured after it (below).
         let safe = limit * (1.0 - 1e-9);
         let exact = self.levels == 0 || self.moved_bound + 2.0 * SQRT_3 * self.last_move >= safe;
-        let x_ref = if exact { &self.x_near[..] } else { &[] };
+        let x_ref = if exact { &self.x_near.x[..] } else { &[] };
         let st = if self.levels == 0 {
             let st1 =
                 pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
@@ -104,13 +103,16 @@ impl DemSystem {
                 (self.largest_disp2(), true)
             }
         };
+        let mut due = false;
         if measured {
-            // The computed distance is within a few ε of the true one.
-            self.moved_bound = disp2.sqrt() * (1.0 + 1e-12);
+            // The computed distance is within a few ε, and the stored position's rounding, of
+            // the true one.
+            self.moved_bound = (disp2.sqrt() + self.x_near.err) * (1.0 + 1e-12);
+            due = self.moved_bound > limit;
         }
-        if disp2 > refresh_disp2 || self.rebuild_due {
+        if due || self.rebuild_due {
             let t0 = std::time::Instant::now();
-            if disp2 > refresh_disp2 {
+            if due {
                 self.refresh();
             }
             if self.rebuild_due {

@@ -7,6 +7,7 @@ use super::forces::{Past, Scratch};
 use super::kernel::Kernel;
 use super::near_list::NearList;
 use super::neighbors::NeighborList;
+use super::reference::RefPositions;
 use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
@@ -23,8 +24,8 @@ pub struct DemSystem {
     /// Slot of `past` holding the newer values.
     pub(super) ring: u8,
     /// Positions at the last Verlet-list build and at the last near-list refresh.
-    pub(super) x_build: Vec<V3>,
-    pub(super) x_near: Vec<V3>,
+    pub(super) x_build: RefPositions,
+    pub(super) x_near: RefPositions,
     /// External forces; empty until a coupling sets them (a DEM-only scene reads none).
     pub(super) ext: Vec<V3>,
     pub(super) ids: Vec<u32>,
@@ -54,9 +55,9 @@ pub struct DemSystem {
     pub(super) moved_bound: f64,
     #[serde(skip)]
     pub(super) last_move: f64,
-    /// Storage reused by near-list refreshes (the previous list's, and a code per entry).
+    /// Scratch of the near-list refreshes: a selection code per Verlet-list entry.
     #[serde(skip)]
-    pub(super) spare: (NearList, Vec<u8>),
+    pub(super) near_codes: Vec<u8>,
     #[serde(skip)]
     pub(super) sc_threads: usize,
     /// Wall time of near-list refreshes and Verlet-list rebuilds (timers).
@@ -89,8 +90,8 @@ impl DemSystem {
             w: vec![[0.0; 3]; n],
             past: Past::zeros(n),
             ring: 0,
-            x_build: Vec::new(),
-            x_near: Vec::new(),
+            x_build: RefPositions::default(),
+            x_near: RefPositions::default(),
             ext: Vec::new(),
             ids: (0..n as u32).collect(),
             outer: NeighborList::default(),
@@ -106,7 +107,7 @@ impl DemSystem {
             last: (0.0, f64::NEG_INFINITY),
             moved_bound: unknown_bound(),
             last_move: 0.0,
-            spare: Default::default(),
+            near_codes: Vec::new(),
             sc_threads: 0,
             neighbour_s: 0.0,
             sc: Scratch::default(),

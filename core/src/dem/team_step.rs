@@ -14,6 +14,7 @@ use super::kernel::Kernel;
 use super::neighbors::{Hist, NeighborList};
 use super::pair_scatter::PairSum;
 use super::particle_pass::{block_walls, update_block_on, BlockMotion, Weights, BLOCK};
+use super::reference::RefV3;
 use super::steal_ranges::StealRanges;
 use super::walls::WallList;
 use super::work_split::Sums;
@@ -54,7 +55,7 @@ pub(crate) fn team_step<const FR: bool>(
     p: &DemParams,
     step: Weights,
     s: StepState,
-    x_ref: &[V3],
+    x_ref: &[RefV3],
     ext: &[V3],
 ) -> Stats {
     let StepState { x, v, w, past, walls, nl, sc } = s;

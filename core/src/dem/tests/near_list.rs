@@ -152,3 +152,110 @@ fn near_list_pair_pass_equals_the_whole_lists() {
     }
     assert_eq!(live, s.near.list.touch.iter().filter(|&&t| t == 1).count(), "a live history was dropped");
 }
+
+/// The near list's arrays as bits, to compare two lists exactly.
+fn list_bits(nl: &NeighborList) -> (Vec<u32>, Vec<u32>, Vec<u8>, Vec<u32>) {
+    let shear = nl.shear.iter().flatten().map(|v| v.to_bits()).collect();
+    (nl.offsets.clone(), nl.nbr.clone(), nl.touch.clone(), shear)
+}
+
+#[test]
+fn a_refresh_in_place_equals_a_fresh_selection() {
+    // The colliding gas of `near_list_holds_every_touching_pair`: live histories, lists that
+    // grow and shrink from refresh to refresh.
+    let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
+    let d = case.particles.diameter_m;
+    let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
+    let mut s = DemSystem::new(&case, x, v);
+    let base_gap = s.p.near_gap();
+    let (mut compared, mut moved_rows, mut live) = (0, 0, 0);
+    for round in 0..40 {
+        for _ in 0..7 {
+            s.step();
+        }
+        // Gaps that keep the list, shrink it to the live entries, or take the whole Verlet list
+        // (shifts larger than a part), each from the list the previous gap left.
+        let mut near = s.near.clone();
+        for gap in [base_gap, 0.0, 10.0 * d, 0.5 * base_gap, base_gap] {
+            let want = NearList::select(&s.outer, &s.x, d, gap, Histories::Near(&near));
+            for part_rows in [1, 7, 64, 1 << 14] {
+                let mut got = near.clone();
+                got.refresh_in_parts(&s.outer, &s.x, d, gap, &mut Vec::new(), part_rows);
+                assert!(
+                    list_bits(&got.list) == list_bits(&want.list),
+                    "round {round}, gap {gap:e}, parts of {part_rows}: the lists differ"
+                );
+                compared += 1;
+            }
+            let changed = near.list.offsets.iter().zip(&want.list.offsets).filter(|(a, b)| a != b).count();
+            moved_rows += changed;
+            live += want.list.touch.iter().filter(|&&t| t != 0).count();
+            near = want;
+        }
+    }
+    assert!(compared == 800 && moved_rows > 10_000 && live > 1_000, "{moved_rows} rows moved, {live} live entries");
+}
+
+/// Live histories by particle-id pair (i < j by id, ξ oriented from the smaller id).
+fn live_by_id(s: &DemSystem) -> HashMap<(u32, u32), [u32; 3]> {
+    let (nl, ids) = (&s.near.list, s.ids());
+    let mut out = HashMap::new();
+    for i in 0..s.len() {
+        for k in nl.offsets[i] as usize..nl.offsets[i + 1] as usize {
+            if nl.touch[k] != 0 {
+                let (a, b) = (ids[i], ids[nl.nbr[k] as usize]);
+                let h = if a < b { nl.shear[k] } else { nl.shear[k].map(|c| -c) };
+                out.insert((a.min(b), a.max(b)), h.map(f32::to_bits));
+            }
+        }
+    }
+    out
+}
+
+#[test]
+fn a_rebuild_carries_every_live_history_by_particle_id() {
+    let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
+    let d = case.particles.diameter_m;
+    let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
+    let mut s = DemSystem::new(&case, x, v);
+    let mut carried = 0;
+    for _ in 0..40 {
+        for _ in 0..13 {
+            s.step();
+        }
+        let before = live_by_id(&s);
+        // Reverse the order, so that the re-sort moves every particle and flips orientations.
+        s.x.reverse();
+        s.v.reverse();
+        s.w.reverse();
+        s.ids.reverse();
+        for slot in s.past.v.iter_mut().chain(&mut s.past.a).chain(&mut s.past.alpha) {
+            slot.reverse();
+        }
+        let n = s.len() as u32;
+        let nl = &mut s.near.list;
+        let mut rows: Vec<Vec<(u32, [f32; 3], u8)>> = (0..n as usize).map(|_| Vec::new()).collect();
+        for i in 0..n as usize {
+            for k in nl.offsets[i] as usize..nl.offsets[i + 1] as usize {
+                let (a, b) = (n - 1 - i as u32, n - 1 - nl.nbr[k]);
+                let (lo, hi, h) = if a < b { (a, b, nl.shear[k]) } else { (b, a, nl.shear[k].map(|c| -c)) };
+                rows[lo as usize].push((hi, h, nl.touch[k]));
+            }
+        }
+        *nl = crate::dem::neighbors::NeighborList::default();
+        nl.offsets.push(0);
+        for r in rows {
+            for (j, h, t) in r {
+                nl.nbr.push(j);
+                nl.shear.push(h);
+                nl.touch.push(t);
+            }
+            nl.offsets.push(nl.nbr.len() as u32);
+        }
+        assert_eq!(live_by_id(&s), before, "the reversed list holds the same histories");
+        s.rebuild();
+        assert_eq!(live_by_id(&s), before, "a history was lost or changed by the rebuild");
+        carried += before.len();
+    }
+    assert!(carried > 500, "only {carried} live histories carried");
+}
