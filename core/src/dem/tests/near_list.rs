@@ -36,14 +36,18 @@ fn near_pairs(s: &DemSystem) -> HashSet<(u32, u32)> {
     set
 }
 
-#[test]
-fn near_list_holds_every_touching_pair() {
-    // 400 particles at up to 1.5 m/s under gravity in a closed column: they cross the near gap
-    // (0.045 d) in about 30 steps, so the run refreshes and rebuilds many times.
+/// 400 particles at up to 1.5 m/s under gravity in a closed column, and their diameter: they
+/// cross the near gap (0.045 d) in about 30 steps, so a run refreshes and rebuilds many times.
+fn colliding_gas() -> (DemSystem, f64) {
     let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
     let d = case.particles.diameter_m;
     let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
-    let mut s = DemSystem::new(&case, x, v);
+    (DemSystem::new(&case, x, v), d)
+}
+
+#[test]
+fn near_list_holds_every_touching_pair() {
+    let (mut s, d) = colliding_gas();
     let mut touching_seen = 0;
     for _ in 0..2000 {
         s.step();
@@ -161,12 +165,8 @@ fn list_bits(nl: &NeighborList) -> (Vec<u32>, Vec<u32>, Vec<u8>, Vec<u32>) {
 
 #[test]
 fn a_refresh_in_place_equals_a_fresh_selection() {
-    // The colliding gas of `near_list_holds_every_touching_pair`: live histories, lists that
-    // grow and shrink from refresh to refresh.
-    let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
-    let d = case.particles.diameter_m;
-    let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
-    let mut s = DemSystem::new(&case, x, v);
+    // Live histories, lists that grow and shrink from refresh to refresh.
+    let (mut s, d) = colliding_gas();
     let base_gap = s.p.near_gap();
     let (mut compared, mut moved_rows, mut live) = (0, 0, 0);
     for round in 0..40 {
@@ -214,10 +214,7 @@ fn live_by_id(s: &DemSystem) -> HashMap<(u32, u32), [u32; 3]> {
 
 #[test]
 fn a_rebuild_carries_every_live_history_by_particle_id() {
-    let case = with_damping(test_case(0.01, 0.02, true, 9.81, 1e-6), 0.05, 0.05, 0.3);
-    let d = case.particles.diameter_m;
-    let (x, v) = random_gas(400, 0.005, 0.02, d / 2.0, 1.5, 5);
-    let mut s = DemSystem::new(&case, x, v);
+    let (mut s, _) = colliding_gas();
     let mut carried = 0;
     for _ in 0..40 {
         for _ in 0..13 {
