@@ -129,10 +129,34 @@ impl Stats {
 /// `nl` and the arrays hold one row per particle.
 pub(crate) fn pair_pass<const FR: bool>(
     p: &DemParams,
+    state: (&[V3], &[V3], &[V3]),
+    nl: &mut NeighborList,
+    sc: &mut Scratch,
+    kernel: Kernel,
+) -> Stats {
+    pass::<FR>(p, state, nl, sc, kernel, false)
+}
+
+/// `pair_pass` that leaves the list's histories and touch flags as they were (Heun's second
+/// evaluation): each chunk works on a copy of its part of them, so that only the chunks in
+/// flight are copied, not the whole list. The same forces, bit for bit.
+pub(crate) fn pair_pass_keeping_histories<const FR: bool>(
+    p: &DemParams,
+    state: (&[V3], &[V3], &[V3]),
+    nl: &mut NeighborList,
+    sc: &mut Scratch,
+    kernel: Kernel,
+) -> Stats {
+    pass::<FR>(p, state, nl, sc, kernel, true)
+}
+
+fn pass<const FR: bool>(
+    p: &DemParams,
     (x, v, w): (&[V3], &[V3], &[V3]),
     nl: &mut NeighborList,
     sc: &mut Scratch,
     kernel: Kernel,
+    keep: bool,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
@@ -151,7 +175,11 @@ pub(crate) fn pair_pass<const FR: bool>(
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
             let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (&x[a..e], &v[a..e], &w[a..e]));
-            chunk_pairs_on::<FR>(kernel, &args, sh, to, acc)
+            if keep {
+                chunk_pairs_on::<FR>(kernel, &args, &mut sh.to_vec(), &mut to.to_vec(), acc)
+            } else {
+                chunk_pairs_on::<FR>(kernel, &args, sh, to, acc)
+            }
         })
         .reduce(|| Stats::ZERO, Stats::max)
 }

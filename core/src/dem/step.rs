@@ -5,7 +5,7 @@
 //! The first step after a start or a change of parameters is Heun's (PHYSICS.md 7).
 
 use super::contact::V3;
-use super::forces::{narrow, pair_pass, widen, PastV3, Stats};
+use super::forces::{narrow, pair_pass, pair_pass_keeping_histories, widen, PastV3, Stats};
 use super::integrator::weights;
 use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
 use super::system::DemSystem;
@@ -127,7 +127,8 @@ impl DemSystem {
     /// The derivatives live in the past slots: the first evaluation's in the newer slot (the
     /// next step's history), the second's in the older (which the next step's AB2 does not read),
     /// and the corrector adds h/2 (f₁ − f₀) to the predicted state, so the step needs no arrays
-    /// of its own beyond the contact histories' copy.
+    /// of its own beyond a copy of the wall list and, in the second evaluation, of the contact
+    /// histories of the pair-pass chunks in flight.
     pub(super) fn heun<const FR: bool>(&mut self) -> Stats {
         let n = self.x.len();
         let h = self.p.dt;
@@ -144,8 +145,7 @@ impl DemSystem {
             (a0, al0),
         );
         let v0 = &mut q.v[newer];
-        let nl = &self.near.list;
-        let (shear1, touch1, walls1) = (nl.shear.clone(), nl.touch.clone(), self.walls.clone());
+        let walls1 = self.walls.clone();
         let step = |y: &mut V3, f: [f64; 3], c: f64| {
             for k in 0..3 {
                 y[k] += c * f[k];
@@ -158,9 +158,10 @@ impl DemSystem {
             step(&mut self.v[i], widen(a0[i]), h);
             step(&mut self.w[i], widen(al0[i]), h);
         }
-        pair_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.near.list, &mut self.sc, self.kernel);
+        let state = (&self.x[..], &self.v[..], &self.w[..]);
+        pair_pass_keeping_histories::<FR>(&self.p, state, &mut self.near.list, &mut self.sc, self.kernel);
         accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), (a1, al1));
-        (self.near.list.shear, self.near.list.touch, self.walls) = (shear1, touch1, walls1);
+        self.walls = walls1;
         // f₁ − f₀, the first evaluation's as stored.
         let diff = |f1: V3, f0: PastV3| [0, 1, 2].map(|k| f1[k] - f0[k] as f64);
         for i in 0..n {

@@ -256,3 +256,30 @@ fn a_rebuild_carries_every_live_history_by_particle_id() {
     }
     assert!(carried > 500, "only {carried} live histories carried");
 }
+
+#[test]
+fn a_pass_keeping_the_histories_gives_the_same_forces_and_keeps_them() {
+    let (mut s, _) = colliding_gas();
+    for _ in 0..60 {
+        s.step(); // live histories
+    }
+    let n = s.len();
+    for chunks in [1, 3, 8] {
+        let mut sc = Scratch::plan(&s.near.list, n, chunks);
+        let (before, mut kept) = (list_bits(&s.near.list), s.near.list.clone());
+        crate::dem::forces::pair_pass_keeping_histories::<true>(
+            &s.p,
+            (&s.x, &s.v, &s.w),
+            &mut kept,
+            &mut sc,
+            s.kernel(),
+        );
+        assert!(list_bits(&kept) == before, "{chunks} chunks: the histories or flags changed");
+        let on_kept = sc.acc.clone();
+        let mut written = s.near.list.clone();
+        pair_pass::<true>(&s.p, (&s.x, &s.v, &s.w), &mut written, &mut sc, s.kernel());
+        assert!(list_bits(&written) != before, "the plain pass writes nothing either: no test");
+        let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(f32::to_bits).collect::<Vec<_>>();
+        assert!(bits(&on_kept) == bits(&sc.acc), "{chunks} chunks: the forces differ");
+    }
+}
