@@ -2,8 +2,8 @@
 //! small `gap` at its last refresh, or whose contact history is live, kept in the Verlet list's
 //! order. The pair pass walks it instead of the whole list (5.3 entries per particle in the
 //! settled bed, 2.5 of them touching), and the live contact histories are stored with it: a
-//! refresh takes them from the previous near list, a Verlet-list build from the histories it
-//! carried by particle id.
+//! refresh takes them from the previous near list (in its own storage, `near_refresh`), a
+//! Verlet-list build from the live histories carried by particle id (`id_histories`).
 //!
 //! Validity: while no particle has moved more than gap/2 since the refresh, a pair left out
 //! (gap ≥ `gap` then) cannot touch. At a refresh the Verlet list must hold every pair closer than
