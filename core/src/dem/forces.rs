@@ -134,29 +134,19 @@ pub(crate) fn pair_pass<const FR: bool>(
     sc: &mut Scratch,
     kernel: Kernel,
 ) -> Stats {
-    pass::<FR>(p, state, nl, sc, kernel, false)
+    pair_pass_with::<FR>(p, state, nl, sc, kernel, false)
 }
 
-/// `pair_pass` that leaves the list's histories and touch flags as they were (Heun's second
-/// evaluation): each chunk works on a copy of its part of them, so that only the chunks in
-/// flight are copied, not the whole list. The same forces, bit for bit.
-pub(crate) fn pair_pass_keeping_histories<const FR: bool>(
-    p: &DemParams,
-    state: (&[V3], &[V3], &[V3]),
-    nl: &mut NeighborList,
-    sc: &mut Scratch,
-    kernel: Kernel,
-) -> Stats {
-    pass::<FR>(p, state, nl, sc, kernel, true)
-}
-
-fn pass<const FR: bool>(
+/// `pair_pass`, which with `keep_histories` leaves the list's histories and touch flags as they were
+/// (Heun's second evaluation): each chunk then works on a copy of its part of them, so that only
+/// the chunks in flight are copied, not the whole list. The same forces, bit for bit.
+pub(crate) fn pair_pass_with<const FR: bool>(
     p: &DemParams,
     (x, v, w): (&[V3], &[V3], &[V3]),
     nl: &mut NeighborList,
     sc: &mut Scratch,
     kernel: Kernel,
-    keep: bool,
+    keep_histories: bool,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
@@ -175,7 +165,7 @@ fn pass<const FR: bool>(
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
             let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (&x[a..e], &v[a..e], &w[a..e]));
-            if keep {
+            if keep_histories {
                 chunk_pairs_on::<FR>(kernel, &args, &mut sh.to_vec(), &mut to.to_vec(), acc)
             } else {
                 chunk_pairs_on::<FR>(kernel, &args, sh, to, acc)

@@ -267,13 +267,7 @@ fn a_pass_keeping_the_histories_gives_the_same_forces_and_keeps_them() {
     for chunks in [1, 3, 8] {
         let mut sc = Scratch::plan(&s.near.list, n, chunks);
         let (before, mut kept) = (list_bits(&s.near.list), s.near.list.clone());
-        crate::dem::forces::pair_pass_keeping_histories::<true>(
-            &s.p,
-            (&s.x, &s.v, &s.w),
-            &mut kept,
-            &mut sc,
-            s.kernel(),
-        );
+        crate::dem::forces::pair_pass_with::<true>(&s.p, (&s.x, &s.v, &s.w), &mut kept, &mut sc, s.kernel(), true);
         assert!(list_bits(&kept) == before, "{chunks} chunks: the histories or flags changed");
         let on_kept = sc.acc.clone();
         let mut written = s.near.list.clone();
