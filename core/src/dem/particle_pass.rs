@@ -5,9 +5,9 @@
 
 use super::ab_update::{ab_flat, ab_flat_moved};
 use super::contact::{dist2, V3};
-use super::forces::{narrow, Acc, Past, PastV3, Stats};
+use super::forces::{narrow, widen, Acc, Past, PastV3, Stats};
 use super::kernel::{Isa, Kernel};
-use super::reference::{widen, RefV3};
+use super::reference::RefV3;
 use super::walls::{wall_forces, WallList};
 use super::work_split::Sums;
 use super::DemParams;
@@ -307,7 +307,7 @@ fn update_block<const FR: bool, const V: bool>(
     // Largest squared displacement since `x_ref`, as eight partial maxima (a vector
     // max instead of a serial chain; max is exact, so the grouping does not matter).
     let mut part = [0.0f64; 8];
-    for (l, (&xn, xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
+    for (l, (&xn, &xb)) in x.iter().zip(&x_ref[lo..lo + len]).enumerate() {
         let d2 = dist2(xn, widen(xb));
         part[l % 8] = if d2 > part[l % 8] { d2 } else { part[l % 8] };
     }

@@ -6,10 +6,12 @@
 //! with double-precision references. In a checkpoint they are double (the bytes of earlier builds).
 
 use super::contact::{dist2, V3};
+use super::forces::{narrow, widen, PastV3};
 use rayon::prelude::*;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
-pub type RefV3 = [f32; 3];
+/// A stored position: single precision, as the multistep history's values (`narrow`, `widen`).
+pub type RefV3 = PastV3;
 
 /// Positions stored in single precision and the bound on their rounding.
 #[derive(Clone, Debug, Default)]
@@ -23,7 +25,7 @@ impl RefPositions {
     /// Store `x` (reusing the storage).
     pub fn store(&mut self, x: &[V3]) {
         self.x.clear();
-        self.x.extend(x.iter().map(|p| p.map(|c| c as f32)));
+        self.x.extend(x.iter().map(|&p| narrow(p)));
         self.err = rounding_bound(&self.x);
     }
     pub fn is_empty(&self) -> bool {
@@ -32,17 +34,12 @@ impl RefPositions {
     /// Whether any particle may be farther than `reach` from its stored position.
     pub fn any_beyond(&self, x: &[V3], reach: f64) -> bool {
         let r = (reach - self.err).max(0.0);
-        x.par_iter().zip(&self.x).any(|(&a, b)| dist2(a, widen(b)) > r * r)
+        x.par_iter().zip(&self.x).any(|(&a, &b)| dist2(a, widen(b)) > r * r)
     }
     /// The largest squared distance of a particle from its stored position, as measured.
     pub fn largest_disp2(&self, x: &[V3]) -> f64 {
-        x.par_iter().zip(&self.x).map(|(&a, b)| dist2(a, widen(b))).reduce(|| 0.0, f64::max)
+        x.par_iter().zip(&self.x).map(|(&a, &b)| dist2(a, widen(b))).reduce(|| 0.0, f64::max)
     }
-}
-
-#[inline(always)]
-pub fn widen(r: &RefV3) -> V3 {
-    r.map(f64::from)
 }
 
 /// From the stored values (so that a checkpoint gives back the same bound): a true coordinate
@@ -54,7 +51,7 @@ fn rounding_bound(x: &[RefV3]) -> f64 {
 
 impl Serialize for RefPositions {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(self.x.iter().map(widen))
+        s.collect_seq(self.x.iter().map(|&r| widen(r)))
     }
 }
 
@@ -89,7 +86,7 @@ mod tests {
             let step = 1e-5 * uniform();
             let moved = [p[0] + step, p[1] - step, p[2]];
             let truth = dist2(moved, *p).sqrt();
-            let measured = dist2(moved, widen(&r.x[i])).sqrt();
+            let measured = dist2(moved, widen(r.x[i])).sqrt();
             worst = worst.max((measured - truth).abs());
             if worst > r.err {
                 break;
