@@ -9,6 +9,7 @@ pub mod cfd;
 pub mod coupling;
 pub mod dem;
 pub mod grid;
+pub mod memory;
 pub mod output;
 pub mod sim;
 mod simd;

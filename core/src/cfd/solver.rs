@@ -72,9 +72,7 @@ pub struct GasSolver {
     geo: FaceGeometry,
     prim: Primitives,
     q_old: Vec<[f64; 4]>,
-    stage: Vec<[f64; 4]>,
     face_old: Vec<f64>,
-    face_stage: Vec<f64>,
     /// Axial-face fluxes of the current right-hand side (rhs.rs `axial_layer`).
     axial: Vec<[f64; 7]>,
     parallel: bool,
@@ -165,10 +163,8 @@ impl GasSolver {
             geo,
             prim: Primitives::new(n),
             q_old: vec![[0.0; 4]; n],
-            stage: vec![[0.0; 4]; n],
             face_old: vec![0.0; nf],
             axial: vec![[0.0; 7]; n],
-            face_stage: vec![0.0; nf],
             parallel: n >= PARALLEL_MIN_CELLS,
             team: true,
             pressure_offset: 0.0,
@@ -577,8 +573,9 @@ impl GasSolver {
         }
         self.apply_outlet(dt);
         if hl == 0 {
-            // Heun corrector: y1 = y0 + h/2 (f(y0) + f(y*)).
-            let (mut stage, mut face_stage) = (std::mem::take(&mut self.stage), std::mem::take(&mut self.face_stage));
+            // Heun corrector: y1 = y0 + h/2 (f(y0) + f(y*)); its right-hand sides live for this
+            // first step only.
+            let (mut stage, mut face_stage) = (vec![[0.0; 4]; f_new.len()], vec![0.0; g_new.len()]);
             self.rhs_into(t + dt, &mut stage, &mut face_stage);
             combine(
                 self.st.q.as_flattened_mut(),
@@ -592,7 +589,6 @@ impl GasSolver {
             }
             let net_stage = self.net_inflow(t + dt);
             self.budget.net += 0.5 * dt * net_new + 0.5 * dt * net_stage;
-            (self.stage, self.face_stage) = (stage, face_stage);
             self.apply_outlet(dt);
         }
         self.push_history(newest, (f_new, g_new, net_new), dt);

@@ -134,19 +134,24 @@ pub(crate) fn pair_pass<const FR: bool>(
     sc: &mut Scratch,
     kernel: Kernel,
 ) -> Stats {
-    pair_pass_with::<FR>(p, state, nl, sc, kernel, false)
+    pair_pass_with::<FR>(p, state, nl, sc, kernel, None)
 }
 
-/// `pair_pass`, which with `keep_histories` leaves the list's histories and touch flags as they were
-/// (Heun's second evaluation): each chunk then works on a copy of its part of them, so that only
-/// the chunks in flight are copied, not the whole list. The same forces, bit for bit.
+/// Rows per piece of a pass that keeps the histories (Heun's second evaluation): about 15k
+/// entries, 0.2 MB of copies per chunk in flight.
+pub(crate) const KEEP_PIECE_ROWS: usize = 4096;
+
+/// `pair_pass`, which with `keep_in_pieces: Some(rows)` leaves the list's histories and touch
+/// flags as they were (Heun's second evaluation): each chunk then works through its rows `rows`
+/// at a time on a copy of their histories, so that only those are copied, not the whole list.
+/// The same forces, bit for bit: a chunk's touching pairs reach its buffer in the same order.
 pub(crate) fn pair_pass_with<const FR: bool>(
     p: &DemParams,
     (x, v, w): (&[V3], &[V3], &[V3]),
     nl: &mut NeighborList,
     sc: &mut Scratch,
     kernel: Kernel,
-    keep_histories: bool,
+    keep_in_pieces: Option<usize>,
 ) -> Stats {
     let offsets = &nl.offsets;
     let nbr = &nl.nbr;
@@ -165,10 +170,24 @@ pub(crate) fn pair_pass_with<const FR: bool>(
         .map(|(a, b, sh, to, acc)| {
             let e = a + acc.len();
             let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (&x[a..e], &v[a..e], &w[a..e]));
-            if keep_histories {
-                chunk_pairs_on::<FR>(kernel, &args, &mut sh.to_vec(), &mut to.to_vec(), acc)
-            } else {
-                chunk_pairs_on::<FR>(kernel, &args, sh, to, acc)
+            match keep_in_pieces {
+                Some(rows) if FR => {
+                    let (mut sh_copy, mut to_copy) = (Vec::new(), Vec::new());
+                    let mut st = Stats::ZERO;
+                    acc.fill(PairSum::default()); // also for a chunk without rows
+                    for from in (a..b).step_by(rows.max(1)) {
+                        let to_row = (from + rows.max(1)).min(b);
+                        let (k0, k1) = ((offsets[from] - offsets[a]) as usize, (offsets[to_row] - offsets[a]) as usize);
+                        sh_copy.clear();
+                        sh_copy.extend_from_slice(&sh[k0..k1]);
+                        to_copy.clear();
+                        to_copy.extend_from_slice(&to[k0..k1]);
+                        let piece = args.rows(from, to_row);
+                        st = st.max(chunk_pairs_on::<FR>(kernel, &piece, &mut sh_copy, &mut to_copy, acc));
+                    }
+                    st
+                }
+                _ => chunk_pairs_on::<FR>(kernel, &args, sh, to, acc),
             }
         })
         .reduce(|| Stats::ZERO, Stats::max)
@@ -176,10 +195,12 @@ pub(crate) fn pair_pass_with<const FR: bool>(
 
 /// Read-only inputs of one chunk of the pair pass: rows a..b, the entries of the half list
 /// from `offsets[a]` to `offsets[b]`, and the positions, velocities and spins of the chunk's
-/// window, particles a..e (rows and partners).
+/// window, particles a..e (rows and partners). A piece of it (`rows`) scans rows from..b only,
+/// into the buffer that the pieces before it filled.
 pub(crate) struct ChunkArgs<'a> {
     pub pair: PairInputs<'a>,
     pub entries: Entries<'a>,
+    pub from: usize,
     pub b: usize,
     pub offsets: &'a [u32],
 }
@@ -199,9 +220,16 @@ impl<'a> ChunkArgs<'a> {
         ChunkArgs {
             pair: PairInputs { law: &p.pair, audit: p.audit, r, h, v, w },
             entries: Entries { owner, nbr, first: a, x, d2: 4.0 * r * r },
+            from: a,
             b,
             offsets,
         }
+    }
+
+    /// Rows from..b of the chunk (a ≤ from ≤ b ≤ its b), on the same window and buffer.
+    pub fn rows(&self, from: usize, b: usize) -> ChunkArgs<'a> {
+        assert!(self.entries.first <= from && from <= b && b <= self.b, "a piece inside the chunk");
+        ChunkArgs { pair: self.pair, entries: self.entries, from, b, offsets: self.offsets }
     }
 }
 
@@ -276,9 +304,11 @@ fn chunk_pairs<const FR: bool, const V: bool>(
 ) -> Stats {
     let (e, a) = (&c.entries, c.entries.first);
     let (owner, nbr, x, d2) = (e.owner, e.nbr, e.x, e.d2);
-    acc.fill(PairSum::default());
+    if c.from == a {
+        acc.fill(PairSum::default()); // a later piece adds to the sums of the ones before it
+    }
     let mut st = Stats::ZERO;
-    let (base, end) = (c.offsets[a] as usize, c.offsets[c.b] as usize);
+    let (base, end) = (c.offsets[c.from] as usize, c.offsets[c.b] as usize);
     let mut batch = Batch::new();
     // One flat loop over the chunk's entries (the row of entry k is owner[k]): no row loop,
     // no data-dependent branch. Every entry is written into lane m; only touching ones

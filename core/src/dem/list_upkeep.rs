@@ -18,7 +18,7 @@ impl DemSystem {
             self.rebuild_due = true;
             return;
         }
-        self.near.refresh(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap(), &mut self.near_codes);
+        self.near.refresh(&self.outer, &self.x, 2.0 * self.p.radius, self.p.near_gap());
         self.sc.bounds.clear(); // replanned for the new list at the next step
         self.x_near.store(&self.x);
         self.moved_bound = self.x_near.err; // a bound on the measured distance too
@@ -55,9 +55,8 @@ impl DemSystem {
         let nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
         let carried = if self.p.friction { IdHistories::of(&self.near.list, &old_ids) } else { Default::default() };
         // The old near list's storage takes the new one (its histories are carried by now).
-        let code = &mut self.near_codes;
         let hist = Histories::Carried(&carried, &self.ids);
-        self.near.select_into(&nl, &self.x, diameter, self.p.near_gap(), hist, code);
+        self.near.select_into(&nl, &self.x, diameter, self.p.near_gap(), hist);
         self.outer = nl;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));

@@ -72,25 +72,17 @@ impl NearList {
     #[cfg(test)]
     pub fn select(outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) -> NearList {
         let mut out = NearList::default();
-        out.select_into(outer, x, diameter, gap, hist, &mut Vec::new());
+        out.select_into(outer, x, diameter, gap, hist);
         out
     }
 
     /// `select` into this list's storage (its old contents are dropped; reusing the memory
-    /// spares the page faults of fresh allocations). `code` is scratch, one byte per entry of
-    /// `outer`: `SKIP`, `TAKE` (with `outer`'s history; none under `Histories::Near`) or
+    /// spares the page faults of fresh allocations). A selection code per entry of `outer`, held
+    /// only while it runs (a byte per Verlet-list entry): `SKIP`, `TAKE` (with `outer`'s history; none under `Histories::Near`) or
     /// `TAKE_OLD` (with the history of the old near entry of the same partner, found again in
     /// sweep 2 by walking the old row beside the list row). Two parallel sweeps: codes and row
     /// counts, then the rows copied into place.
-    pub fn select_into(
-        &mut self,
-        outer: &NeighborList,
-        x: &[V3],
-        diameter: f64,
-        gap: f64,
-        hist: Histories,
-        code: &mut Vec<u8>,
-    ) {
+    pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) {
         let n = outer.offsets.len().saturating_sub(1);
         let total_in = outer.nbr.len();
         assert!(x.len() == n, "one position per list row");
@@ -107,14 +99,11 @@ impl NearList {
             }
         };
         let from_old = matches!(hist, Histories::Near(_));
-        let counts = select_codes(outer, x, diameter, gap, hist, code);
-        // Offsets, then sweep 2: each block's kept entries copied into its part of the storage.
+        let mut code = Vec::new();
+        let new_off = select_codes(outer, x, diameter, gap, hist, &mut code);
+        // Sweep 2: each block's kept entries copied into its part of the storage.
         let l = &mut self.list;
-        l.offsets.clear();
-        l.offsets.push(0);
-        for c in &counts {
-            l.offsets.push(l.offsets.last().unwrap() + c);
-        }
+        l.offsets = new_off;
         let total = l.offsets[n] as usize;
         resize_reused(&mut l.nbr, total, 0);
         resize_reused(&mut l.shear, total, [0.0; 3]);
@@ -165,8 +154,8 @@ pub(super) fn blocks_of(n: usize) -> Vec<std::ops::Range<usize>> {
 }
 
 /// Sweep 1 of a selection, in parallel blocks: a code per entry of `outer` into `code` (`SKIP`,
-/// `TAKE`, or `TAKE_OLD` where the old near list of `hist` has the entry), and the kept entries
-/// of each row. Reads the old near list only.
+/// `TAKE`, or `TAKE_OLD` where the old near list of `hist` has the entry), and the offsets of the
+/// new list's rows (the kept entries counted, then summed in place). Reads the old near list only.
 pub(super) fn select_codes(
     outer: &NeighborList,
     x: &[V3],
@@ -183,11 +172,11 @@ pub(super) fn select_codes(
     let reach2 = (diameter + gap) * (diameter + gap);
     code.clear();
     resize_reused(code, outer.nbr.len(), 0);
-    let mut counts = vec![0u32; n];
+    let mut counts = vec![0u32; n + 1];
     let blocks = blocks_of(n);
     let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
     let mut work = Vec::with_capacity(blocks.len());
-    let (mut crest, mut nrest) = (&mut code[..], &mut counts[..]);
+    let (mut crest, mut nrest) = (&mut code[..], &mut counts[1..]);
     for r in &blocks {
         let (c0, c1) = std::mem::take(&mut crest).split_at_mut(entries(r).len());
         let (n0, n1) = std::mem::take(&mut nrest).split_at_mut(r.len());
@@ -221,5 +210,8 @@ pub(super) fn select_codes(
             assert!(p == p_end, "old near row {i} is not a subsequence of the list row");
         }
     });
+    for i in 0..n {
+        counts[i + 1] += counts[i];
+    }
     counts
 }

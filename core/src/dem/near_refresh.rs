@@ -58,8 +58,8 @@ struct Part<'a> {
 impl NearList {
     /// Redraw this list, drawn from `outer` before, from `outer` at positions `x` in its own
     /// storage: the same entries, histories and flags as `select_into` with `Histories::Near`.
-    pub fn refresh(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, code: &mut Vec<u8>) {
-        self.refresh_in_parts(outer, x, diameter, gap, code, PART_ROWS);
+    pub fn refresh(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64) {
+        self.refresh_in_parts(outer, x, diameter, gap, PART_ROWS);
     }
 
     /// `refresh` with parts of `part_rows` rows (tests cut small parts).
@@ -69,19 +69,15 @@ impl NearList {
         x: &[V3],
         diameter: f64,
         gap: f64,
-        code: &mut Vec<u8>,
         part_rows: usize,
     ) {
         let n = outer.offsets.len().saturating_sub(1);
         assert!(x.len() == n && self.list.offsets.len() == n + 1, "near list of another list");
-        let counts = select_codes(outer, x, diameter, gap, Histories::Near(self), code);
+        // A selection code per Verlet-list entry, held only while the refresh runs.
+        let mut code = Vec::new();
+        let new_off = select_codes(outer, x, diameter, gap, Histories::Near(self), &mut code);
         let l = &mut self.list;
         let old_off = std::mem::take(&mut l.offsets);
-        let mut new_off = Vec::with_capacity(n + 1);
-        new_off.push(0u32);
-        for c in counts {
-            new_off.push(new_off.last().unwrap() + c);
-        }
         let new_total = new_off[n] as usize;
         let parts = part_cuts(&old_off, &new_off, part_rows);
         // Old entries that another part's range covers, copied out while nothing has moved.

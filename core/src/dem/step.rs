@@ -5,7 +5,7 @@
 //! The first step after a start or a change of parameters is Heun's (PHYSICS.md 7).
 
 use super::contact::V3;
-use super::forces::{narrow, pair_pass, pair_pass_with, widen, PastV3, Stats};
+use super::forces::{narrow, pair_pass, pair_pass_with, widen, PastV3, Stats, KEEP_PIECE_ROWS};
 use super::integrator::weights;
 use super::particle_pass::{accel_pass, update_pass, Motion, Weights};
 use super::system::DemSystem;
@@ -159,7 +159,7 @@ impl DemSystem {
             step(&mut self.w[i], widen(al0[i]), h);
         }
         let state = (&self.x[..], &self.v[..], &self.w[..]);
-        pair_pass_with::<FR>(&self.p, state, &mut self.near.list, &mut self.sc, self.kernel, true);
+        pair_pass_with::<FR>(&self.p, state, &mut self.near.list, &mut self.sc, self.kernel, Some(KEEP_PIECE_ROWS));
         accel_pass::<FR>(&self.p, (&self.x, &self.v, &self.w), &mut self.walls, &self.ext, self.sc.sums(), (a1, al1));
         self.walls = walls1;
         // f₁ − f₀, the first evaluation's as stored.

@@ -55,9 +55,6 @@ pub struct DemSystem {
     pub(super) moved_bound: f64,
     #[serde(skip)]
     pub(super) last_move: f64,
-    /// Scratch of the near-list refreshes: a selection code per Verlet-list entry.
-    #[serde(skip)]
-    pub(super) near_codes: Vec<u8>,
     #[serde(skip)]
     pub(super) sc_threads: usize,
     /// Wall time of near-list refreshes and Verlet-list rebuilds (timers).
@@ -107,7 +104,6 @@ impl DemSystem {
             last: (0.0, f64::NEG_INFINITY),
             moved_bound: unknown_bound(),
             last_move: 0.0,
-            near_codes: Vec::new(),
             sc_threads: 0,
             neighbour_s: 0.0,
             sc: Scratch::default(),

@@ -108,6 +108,7 @@ pub struct Simulation {
 impl Simulation {
     /// Build a run: the settled bed (poured, or loaded from `cache_dir`), the gas, the plan.
     pub fn new(case: Case, cache_dir: Option<&Path>) -> Result<Simulation, SimError> {
+        crate::memory::return_freed_memory();
         let (pos, vel) = crate::dem::build_bed(&case, cache_dir).map_err(SimError::Build)?;
         let mut dem = DemSystem::new(&case, pos, vel);
         dem.set_frozen(case.dem.frozen);
@@ -326,6 +327,7 @@ impl Simulation {
     }
 
     pub fn restore(bytes: &[u8]) -> Result<Simulation, SimError> {
+        crate::memory::return_freed_memory();
         let st = checkpoint::decode(bytes).map_err(SimError::Checkpoint)?;
         let grid = fluid_grid(&st.case);
         let mut sim = Simulation::assemble(st, grid);

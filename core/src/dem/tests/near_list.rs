@@ -180,7 +180,7 @@ fn a_refresh_in_place_equals_a_fresh_selection() {
             let want = NearList::select(&s.outer, &s.x, d, gap, Histories::Near(&near));
             for part_rows in [1, 7, 64, 1 << 14] {
                 let mut got = near.clone();
-                got.refresh_in_parts(&s.outer, &s.x, d, gap, &mut Vec::new(), part_rows);
+                got.refresh_in_parts(&s.outer, &s.x, d, gap, part_rows);
                 assert!(
                     list_bits(&got.list) == list_bits(&want.list),
                     "round {round}, gap {gap:e}, parts of {part_rows}: the lists differ"
@@ -264,16 +264,17 @@ fn a_pass_keeping_the_histories_gives_the_same_forces_and_keeps_them() {
         s.step(); // live histories
     }
     let n = s.len();
-    for chunks in [1, 3, 8] {
+    for (chunks, rows) in [(1, 1), (1, 4096), (3, 7), (3, 100_000), (8, 33)] {
         let mut sc = Scratch::plan(&s.near.list, n, chunks);
         let (before, mut kept) = (list_bits(&s.near.list), s.near.list.clone());
-        crate::dem::forces::pair_pass_with::<true>(&s.p, (&s.x, &s.v, &s.w), &mut kept, &mut sc, s.kernel(), true);
-        assert!(list_bits(&kept) == before, "{chunks} chunks: the histories or flags changed");
+        let keep = Some(rows);
+        crate::dem::forces::pair_pass_with::<true>(&s.p, (&s.x, &s.v, &s.w), &mut kept, &mut sc, s.kernel(), keep);
+        assert!(list_bits(&kept) == before, "{chunks} chunks, pieces of {rows}: the histories or flags changed");
         let on_kept = sc.acc.clone();
         let mut written = s.near.list.clone();
         pair_pass::<true>(&s.p, (&s.x, &s.v, &s.w), &mut written, &mut sc, s.kernel());
         assert!(list_bits(&written) != before, "the plain pass writes nothing either: no test");
         let bits = |a: &[PairSum]| a.iter().flat_map(|r| r.0).map(f32::to_bits).collect::<Vec<_>>();
-        assert!(bits(&on_kept) == bits(&sc.acc), "{chunks} chunks: the forces differ");
+        assert!(bits(&on_kept) == bits(&sc.acc), "{chunks} chunks, pieces of {rows}: the forces differ");
     }
 }
