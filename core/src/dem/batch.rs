@@ -103,12 +103,12 @@ pub(crate) struct PairInputs<'a> {
     pub w: &'a [V3],
 }
 
-/// The list entries a chunk scans: the row (`owner`) and partner (`nbr`) of each entry as
-/// particle indices, the positions of the chunk's window (particles first..first + x.len()), and
-/// contact where r² < d2.
+/// The list entries a chunk scans: the row of each entry less the chunk's first row (`owner`,
+/// `work_split::MAX_CHUNK_ROWS` bounds it) and its partner (`nbr`) as a particle index, the
+/// positions of the chunk's window (particles first..first + x.len()), and contact where r² < d2.
 #[derive(Clone, Copy)]
 pub(crate) struct Entries<'a> {
-    pub owner: &'a [u32],
+    pub owner: &'a [u16],
     pub nbr: &'a [u32],
     pub first: usize,
     pub x: &'a [V3],

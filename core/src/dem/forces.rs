@@ -212,7 +212,7 @@ impl<'a> ChunkArgs<'a> {
         a: usize,
         b: usize,
         offsets: &'a [u32],
-        owner: &'a [u32],
+        owner: &'a [u16],
         nbr: &'a [u32],
         (x, v, w): (&'a [V3], &'a [V3], &'a [V3]),
     ) -> Self {
@@ -310,7 +310,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(
     let mut st = Stats::ZERO;
     let (base, end) = (c.offsets[c.from] as usize, c.offsets[c.b] as usize);
     let mut batch = Batch::new();
-    // One flat loop over the chunk's entries (the row of entry k is owner[k]): no row loop,
+    // One flat loop over the chunk's entries (the row of entry k is a + owner[k]): no row loop,
     // no data-dependent branch. Every entry is written into lane m; only touching ones
     // advance m.
     let mut m = 0;
@@ -336,7 +336,7 @@ fn chunk_pairs<const FR: bool, const V: bool>(
         }
     }
     for k in k..end {
-        let (i, j) = (owner[k].wrapping_sub(a as u32) as usize, nbr[k].wrapping_sub(a as u32) as usize);
+        let (i, j) = (owner[k] as usize, nbr[k].wrapping_sub(a as u32) as usize);
         let (xi, xj) = (x[i], x[j]);
         let dx = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
         let r2 = dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2];

@@ -59,7 +59,7 @@ unsafe fn scan8_avx512<const FR: bool>(
     let &Entries { owner, nbr, first, x, d2 } = e;
     debug_assert!(k + LANES <= owner.len() && k + LANES <= nbr.len() && m <= CAP - LANES);
     let at = _mm256_set1_epi32(first as u32 as i32);
-    let oi = _mm256_sub_epi32(_mm256_loadu_si256(owner.as_ptr().add(k) as *const __m256i), at);
+    let oi = _mm256_cvtepu16_epi32(_mm_loadu_si128(owner.as_ptr().add(k) as *const __m128i));
     let oj = _mm256_sub_epi32(_mm256_loadu_si256(nbr.as_ptr().add(k) as *const __m256i), at);
     // Indices below first wrap to large unsigned values, so one compare checks both ends.
     let len = _mm256_set1_epi32(x.len() as i32);
@@ -69,8 +69,7 @@ unsafe fn scan8_avx512<const FR: bool>(
     let (ti, tj) = (_mm256_add_epi32(_mm256_add_epi32(oi, oi), oi), _mm256_add_epi32(_mm256_add_epi32(oj, oj), oj));
     let p = x.as_ptr() as *const f64;
     // The rows of eight consecutive entries are ascending (the list's order).
-    let rel = |o: u32| o.wrapping_sub(first as u32) as usize; // the lanes' values, checked above
-    let (i0, i7) = (rel(owner[k]), rel(owner[k + 7]));
+    let (i0, i7) = (owner[k] as usize, owner[k + 7] as usize); // the lanes' values, checked above
     let rows = Rows::new(p, i0, i7, x.len(), ti, 0xff);
     let mut dx = [_mm512_setzero_pd(); 3];
     for (a, d) in dx.iter_mut().enumerate() {

@@ -13,6 +13,9 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 /// the first of two threads 7% slower / 1% slower / 5% faster in the pair pass.
 const TOUCH_WEIGHT: usize = 2;
 
+/// Rows per chunk at most, so that an entry's row within its chunk fits in 16 bits (`owner`).
+pub(crate) const MAX_CHUNK_ROWS: usize = 1 << 16;
+
 /// Work split of the pair pass: contiguous particle chunks [a, b), each accumulating its pair
 /// forces (on i and on j) into a private buffer covering particles [a, e), e = 1 + the largest
 /// partner index of the chunk. The cuts depend on the list, its touch flags when planned and the
@@ -26,8 +29,8 @@ pub struct Scratch {
     /// Start of each chunk's buffer in `acc`.
     pub start: Vec<usize>,
     pub acc: Vec<PairSum>,
-    /// Row (first particle) of every list entry.
-    pub owner: Vec<u32>,
+    /// Row (first particle) of every list entry, less its chunk's first row.
+    pub owner: Vec<u16>,
     /// The chunk count the plan was made for.
     chunks: usize,
     /// A restored plan (its chunk count and cuts), taken by the next `replan` for that count.
@@ -135,7 +138,7 @@ impl Scratch {
             Some(p) => p.cuts,
             None => Self::balanced_cuts(nl, n, chunks),
         };
-        self.plan_at(nl, n, &cuts);
+        self.plan_at(nl, n, &rows_capped(cuts));
         self.chunks = chunks;
     }
 
@@ -167,10 +170,11 @@ impl Scratch {
         (0..=nc).map(cut).collect()
     }
 
-    /// The plan of chunks [cuts[c], cuts[c + 1]).
+    /// The plan of chunks [cuts[c], cuts[c + 1]), none longer than `MAX_CHUNK_ROWS`.
     fn plan_at(&mut self, nl: &NeighborList, n: usize, cuts: &[usize]) {
         let (total, nc) = (nl.nbr.len(), cuts.len() - 1);
-        assert!(cuts[0] == 0 && cuts[nc] == n && cuts.windows(2).all(|c| c[0] <= c[1]), "chunk cuts {cuts:?}");
+        let ordered = cuts.windows(2).all(|c| c[0] <= c[1] && c[1] - c[0] <= MAX_CHUNK_ROWS);
+        assert!(cuts[0] == 0 && cuts[nc] == n && ordered, "chunk cuts {cuts:?}");
         let cut = |c: usize| cuts[c];
         let (mut acc, mut owner) = (std::mem::take(&mut self.acc), std::mem::take(&mut self.owner));
         resize_reused(&mut owner, total, 0);
@@ -193,7 +197,7 @@ impl Scratch {
                     for (k, &j) in (k0..k1).zip(&nl.nbr[k0..k1]) {
                         assert!(j as usize > i && (j as usize) < n, "half list holds i < j < n only");
                         e = e.max(j as usize + 1);
-                        own[k - base] = i as u32;
+                        own[k - base] = (i - a) as u16;
                     }
                 }
                 [a, b, e]
@@ -208,4 +212,18 @@ impl Scratch {
         resize_reused(&mut acc, start[nc], PairSum::default());
         (self.bounds, self.start, self.acc, self.owner) = (bounds, start, acc, owner);
     }
+}
+
+/// `cuts` with every chunk longer than `MAX_CHUNK_ROWS` rows cut into equal parts that are not
+/// (a plan of a bed past 4 × 65,536 particles, or one from a checkpoint).
+fn rows_capped(cuts: Vec<usize>) -> Vec<usize> {
+    if cuts.windows(2).all(|c| c[1] - c[0] <= MAX_CHUNK_ROWS) {
+        return cuts;
+    }
+    let mut out = vec![cuts[0]];
+    for c in cuts.windows(2) {
+        let parts = (c[1] - c[0]).div_ceil(MAX_CHUNK_ROWS).max(1);
+        out.extend((1..=parts).map(|p| c[0] + (c[1] - c[0]) * p / parts));
+    }
+    out
 }

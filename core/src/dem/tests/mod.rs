@@ -14,6 +14,7 @@ mod restitution;
 mod sliding;
 mod team_step;
 mod wall_loads;
+mod work_split;
 
 use crate::case::{Bed, Case, Column, Damping, ExplicitBed, Particles};
 
