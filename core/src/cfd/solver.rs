@@ -154,7 +154,9 @@ impl GasSolver {
         let n = grid.num_cells();
         let geo = FaceGeometry::new(&grid);
         let nf = n + grid.nz * geo.faces.len();
-        if st.face_flux.len() != nf || st.hist_face.iter().any(|h| h.len() != nf) {
+        // A forward–backward run keeps one slot of face right-hand sides (`take_face_slot`).
+        let slots_fit = st.hist_face.iter().all(|h| h.len() == nf || h.is_empty());
+        if st.face_flux.len() != nf || !slots_fit || st.hist_face.iter().all(|h| h.is_empty()) {
             st.face_flux = vec![0.0; nf];
             st.hist_face = [vec![0.0; nf], vec![0.0; nf], vec![0.0; nf]];
         }
@@ -235,6 +237,11 @@ impl GasSolver {
     }
     pub fn time_scheme(&self) -> TimeScheme {
         self.scheme
+    }
+    /// Slots of face right-hand sides held (tests).
+    #[cfg(test)]
+    pub(crate) fn face_history_slots(&self) -> usize {
+        self.st.hist_face.iter().filter(|h| !h.is_empty()).count()
     }
     pub fn time(&self) -> f64 {
         self.st.time
@@ -633,7 +640,7 @@ impl GasSolver {
     fn team_step(&mut self, dt: f64) {
         let newest = (self.st.head + 1) % 3;
         let mut f_new = std::mem::take(&mut self.st.hist[newest]);
-        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        let mut g_new = self.take_face_slot(newest);
         let (i1, i2) = (self.st.head, (self.st.head + 2) % 3);
         let (w, m) = self.multistep_weights(dt);
         let weights = &w[..=m];
@@ -641,7 +648,8 @@ impl GasSolver {
         let two = [&h[i1][..], &h[i2][..]];
         let two_face = [&hf[i1][..], &hf[i2][..]];
         let forward_backward = self.scheme == TimeScheme::ForwardBackward;
-        let (past, past_face) = (&two[..m], &two_face[..m]);
+        let past_face = if forward_backward { &two_face[..0] } else { &two_face[..m] };
+        let past = &two[..m];
         let inp = StepInput {
             geo: &self.geo,
             params: &self.st.params,
@@ -707,9 +715,25 @@ impl GasSolver {
         self.face_old.copy_from_slice(&self.st.face_flux);
         let newest = (self.st.head + 1) % 3;
         let mut f_new = std::mem::take(&mut self.st.hist[newest]);
-        let mut g_new = std::mem::take(&mut self.st.hist_face[newest]);
+        let mut g_new = self.take_face_slot(newest);
         self.rhs_into(t, &mut f_new, &mut g_new);
         (t, newest, f_new, g_new)
+    }
+
+    /// Storage for the step's face right-hand sides: history slot `newest`, or under the
+    /// forward–backward scheme, which reads no past face right-hand side, the newest slot's (so
+    /// that one slot is allocated, not three: 16 B per face); zeros where neither is allocated
+    /// (the first step after a switch of scheme).
+    fn take_face_slot(&mut self, newest: usize) -> Vec<f64> {
+        let nf = self.st.face_flux.len();
+        let mut g = std::mem::take(&mut self.st.hist_face[newest]);
+        if g.len() != nf && self.scheme == TimeScheme::ForwardBackward {
+            g = std::mem::take(&mut self.st.hist_face[self.st.head]);
+        }
+        if g.len() != nf {
+            g = vec![0.0; nf];
+        }
+        g
     }
 
     /// The step's right-hand sides (cells, faces, net inflow) become the newest of the history,
@@ -718,6 +742,13 @@ impl GasSolver {
         self.budget.hist[newest] = net_new;
         self.st.hist[newest] = f_new;
         self.st.hist_face[newest] = g_new;
+        if self.scheme == TimeScheme::ForwardBackward {
+            for (k, slot) in self.st.hist_face.iter_mut().enumerate() {
+                if k != newest {
+                    *slot = Vec::new(); // read by no forward–backward step (`take_face_slot`)
+                }
+            }
+        }
         self.st.head = newest;
         self.st.hist_h = [dt, self.st.hist_h[0]];
         self.st.hist_len = (self.st.hist_len + 1).min(3);

@@ -37,6 +37,7 @@ pub(super) struct StepInput<'a> {
     /// The forward–backward step (forward_backward.rs) instead of AB on the whole right-hand side.
     pub forward_backward: bool,
     pub past: &'a [&'a [[f64; 4]]],
+    /// Past face right-hand sides, one per past cell right-hand side (none for forward–backward).
     pub past_face: &'a [&'a [f64]],
 }
 
@@ -79,7 +80,8 @@ pub(super) fn team_step(inp: &StepInput, s: StepState) {
     assert!(rows.iter().all(|&r| r == n) && pr.iter().chain(&gr).all(|f| f.len() == n), "one row per cell");
     let nface = n + nz * nf;
     assert!([face.len(), face_old.len(), rhs_face.len()].iter().all(|&r| r == nface), "one row per face");
-    assert!(inp.weights.len() == inp.past.len() + 1 && inp.past.len() == inp.past_face.len());
+    let face_past = if inp.forward_backward { 0 } else { inp.past.len() };
+    assert!(inp.weights.len() == inp.past.len() + 1 && inp.past_face.len() == face_past);
     assert!(inp.past.iter().all(|f| f.len() == n) && inp.past_face.iter().all(|f| f.len() == nface));
     let [ux, uy, uz, p, beta, bz] = pr.map(|f| Raw::new(f));
     let [div, gx, gy, gz] = gr.map(|f| Raw::new(f));

@@ -115,3 +115,21 @@ fn stepped_forward_backward_the_gas_mass_budget_closes_to_round_off() {
         assert!(worst < 1e-13, "{outlet:?}, team: budget error {worst:.3e} of the mass held");
     }
 }
+
+/// The forward–backward step reads no past face right-hand side: it holds one slot of them, AB3
+/// three; a switch either way steps on with what the new scheme needs, the gas state finite.
+#[test]
+fn a_forward_backward_run_holds_one_slot_of_face_right_hand_sides() {
+    let mut s = bed_column(TimeScheme::ForwardBackward);
+    let dt = 0.5 * s.stable_dt();
+    let mut slots = vec![];
+    for (scheme, steps) in [(TimeScheme::ForwardBackward, 5), (TimeScheme::Ab3, 5), (TimeScheme::ForwardBackward, 2)] {
+        s.switch_time_scheme(scheme);
+        for _ in 0..steps {
+            s.step(dt);
+        }
+        slots.push(s.face_history_slots());
+        assert!(s.check_finite().is_ok(), "{scheme:?}");
+    }
+    assert_eq!(slots, [1, 3, 1]);
+}
