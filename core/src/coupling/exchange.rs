@@ -148,8 +148,6 @@ pub struct Exchange {
     sub_lost: Vec<[f64; 3]>,
     sub_scratch: Vec<[f64; 3]>,
     sub_count: Vec<u32>,
-    /// `carry_hints`' cell per particle identity.
-    cell_by_id: Vec<u32>,
     /// The particles' identities in their order at the last call, and the caller's count of
     /// re-sorts then (`follow_reorder`).
     hint_ids: Vec<u32>,
@@ -183,7 +181,6 @@ impl Exchange {
             sub_lost: Vec::new(),
             sub_scratch: Vec::new(),
             sub_count: Vec::new(),
-            cell_by_id: Vec::new(),
             hint_ids: Vec::new(),
             hint_order: 0,
         }
@@ -388,13 +385,13 @@ impl Exchange {
         if n != self.cell_of.len() || new_ids.len() != n {
             return;
         }
-        self.cell_by_id.clear();
-        self.cell_by_id.resize(n, 0);
+        // The cell per particle identity, held only while the hints move (4 B per particle).
+        let mut cell_by_id = vec![0; n];
         for (&id, &c) in old_ids.iter().zip(&self.cell_of) {
-            self.cell_by_id[id as usize] = c;
+            cell_by_id[id as usize] = c;
         }
         for (c, &id) in self.cell_of.iter_mut().zip(new_ids) {
-            *c = self.cell_by_id[id as usize];
+            *c = cell_by_id[id as usize];
         }
     }
 
