@@ -2,9 +2,10 @@
 //! the first large free (up to 32 MiB), so later large buffers (a list refresh's codes, a
 //! rebuild's copies) come from its heap and stay resident once freed, on top of the run's live
 //! data. Fixed thresholds keep the resident memory of a run its live data: blocks of 256 KiB or
-//! more are mapped and unmapped, and the heap is trimmed when 256 KiB are free at its top. A
-//! run allocates a few dozen such blocks outside its start (docs/BENCHMARKS.md, "Scaling"). By
-//! hand: `mallopt` is glibc's own setting (through `libc`); no allocator crate is needed for it.
+//! more are mapped and unmapped, and the heap is trimmed when 256 KiB are free at its top. A run
+//! maps such blocks at its start and a few per near-list refresh (tens of steps apart), not per
+//! step (docs/BENCHMARKS.md, "Scaling"). By hand: `mallopt` is glibc's own setting (through
+//! `libc`); no allocator crate is needed for it.
 
 /// Set the thresholds, once per process (later calls do nothing). Other C libraries: nothing.
 pub fn return_freed_memory() {
