@@ -78,10 +78,10 @@ impl NearList {
 
     /// `select` into this list's storage (its old contents are dropped; reusing the memory
     /// spares the page faults of fresh allocations). A selection code per entry of `outer`, held
-    /// only while it runs (a byte per Verlet-list entry): `SKIP`, `TAKE` (with `outer`'s history; none under `Histories::Near`) or
-    /// `TAKE_OLD` (with the history of the old near entry of the same partner, found again in
-    /// sweep 2 by walking the old row beside the list row). Two parallel sweeps: codes and row
-    /// counts, then the rows copied into place.
+    /// only while it runs (a byte per Verlet-list entry): `SKIP`, `TAKE` (with `outer`'s
+    /// history; none under `Histories::Near`) or `TAKE_OLD` (with the history of the old near
+    /// entry of the same partner, found again in sweep 2 by walking the old row beside the list
+    /// row). Two parallel sweeps: codes and row offsets, then the rows copied into place.
     pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) {
         let n = outer.offsets.len().saturating_sub(1);
         let total_in = outer.nbr.len();
@@ -172,11 +172,12 @@ pub(super) fn select_codes(
     let reach2 = (diameter + gap) * (diameter + gap);
     code.clear();
     resize_reused(code, outer.nbr.len(), 0);
-    let mut counts = vec![0u32; n + 1];
+    // Each row's kept entries at its end, summed into offsets below.
+    let mut offsets = vec![0u32; n + 1];
     let blocks = blocks_of(n);
     let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
     let mut work = Vec::with_capacity(blocks.len());
-    let (mut crest, mut nrest) = (&mut code[..], &mut counts[1..]);
+    let (mut crest, mut nrest) = (&mut code[..], &mut offsets[1..]);
     for r in &blocks {
         let (c0, c1) = std::mem::take(&mut crest).split_at_mut(entries(r).len());
         let (n0, n1) = std::mem::take(&mut nrest).split_at_mut(r.len());
@@ -211,7 +212,7 @@ pub(super) fn select_codes(
         }
     });
     for i in 0..n {
-        counts[i + 1] += counts[i];
+        offsets[i + 1] += offsets[i];
     }
-    counts
+    offsets
 }
