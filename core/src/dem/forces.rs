@@ -171,26 +171,36 @@ pub(crate) fn pair_pass_with<const FR: bool>(
             let e = a + acc.len();
             let args = ChunkArgs::new(p, a, b, offsets, owner, nbr, (&x[a..e], &v[a..e], &w[a..e]));
             match keep_in_pieces {
-                Some(rows) if FR => {
-                    let (mut sh_copy, mut to_copy) = (Vec::new(), Vec::new());
-                    let mut st = Stats::ZERO;
-                    acc.fill(PairSum::default()); // also for a chunk without rows
-                    for from in (a..b).step_by(rows.max(1)) {
-                        let to_row = (from + rows.max(1)).min(b);
-                        let (k0, k1) = ((offsets[from] - offsets[a]) as usize, (offsets[to_row] - offsets[a]) as usize);
-                        sh_copy.clear();
-                        sh_copy.extend_from_slice(&sh[k0..k1]);
-                        to_copy.clear();
-                        to_copy.extend_from_slice(&to[k0..k1]);
-                        let piece = args.rows(from, to_row);
-                        st = st.max(chunk_pairs_on::<FR>(kernel, &piece, &mut sh_copy, &mut to_copy, acc));
-                    }
-                    st
-                }
+                Some(rows) if FR => chunk_pairs_keeping::<FR>(kernel, &args, (sh, to), acc, rows.max(1)),
                 _ => chunk_pairs_on::<FR>(kernel, &args, sh, to, acc),
             }
         })
         .reduce(|| Stats::ZERO, Stats::max)
+}
+
+/// One chunk whose histories and flags (`sh`, `to`) stay as they were: its rows `rows` at a time,
+/// each piece on a copy of its entries' histories, all into the same buffer.
+fn chunk_pairs_keeping<const FR: bool>(
+    kernel: Kernel,
+    args: &ChunkArgs,
+    (sh, to): (&[Hist], &[u8]),
+    acc: &mut [PairSum],
+    rows: usize,
+) -> Stats {
+    let (a, b, offsets) = (args.entries.first, args.b, args.offsets);
+    let (mut sh_copy, mut to_copy) = (Vec::new(), Vec::new());
+    let mut st = Stats::ZERO;
+    acc.fill(PairSum::default()); // also for a chunk without rows
+    for from in (a..b).step_by(rows) {
+        let end = (from + rows).min(b);
+        let (k0, k1) = ((offsets[from] - offsets[a]) as usize, (offsets[end] - offsets[a]) as usize);
+        sh_copy.clear();
+        sh_copy.extend_from_slice(&sh[k0..k1]);
+        to_copy.clear();
+        to_copy.extend_from_slice(&to[k0..k1]);
+        st = st.max(chunk_pairs_on::<FR>(kernel, &args.rows(from, end), &mut sh_copy, &mut to_copy, acc));
+    }
+    st
 }
 
 /// Read-only inputs of one chunk of the pair pass: rows a..b, the entries of the half list

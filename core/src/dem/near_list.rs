@@ -99,8 +99,7 @@ impl NearList {
             }
         };
         let from_old = matches!(hist, Histories::Near(_));
-        let mut code = Vec::new();
-        let new_off = select_codes(outer, x, diameter, gap, hist, &mut code);
+        let (code, new_off) = select_codes(outer, x, diameter, gap, hist);
         // Sweep 2: each block's kept entries copied into its part of the storage.
         let l = &mut self.list;
         l.offsets = new_off;
@@ -153,7 +152,7 @@ pub(super) fn blocks_of(n: usize) -> Vec<std::ops::Range<usize>> {
     (0..n.div_ceil(BLOCK)).map(|b| b * BLOCK..((b + 1) * BLOCK).min(n)).collect()
 }
 
-/// Sweep 1 of a selection, in parallel blocks: a code per entry of `outer` into `code` (`SKIP`,
+/// Sweep 1 of a selection, in parallel blocks: a code per entry of `outer` (`SKIP`,
 /// `TAKE`, or `TAKE_OLD` where the old near list of `hist` has the entry), and the offsets of the
 /// new list's rows (the kept entries counted, then summed in place). Reads the old near list only.
 pub(super) fn select_codes(
@@ -162,16 +161,14 @@ pub(super) fn select_codes(
     diameter: f64,
     gap: f64,
     hist: Histories,
-    code: &mut Vec<u8>,
-) -> Vec<u32> {
+) -> (Vec<u8>, Vec<u32>) {
     let (old, carried) = match hist {
         Histories::Near(old) => (Some(old), None),
         Histories::Carried(h, ids) => (None, Some((h, ids))),
     };
     let n = outer.offsets.len().saturating_sub(1);
     let reach2 = (diameter + gap) * (diameter + gap);
-    code.clear();
-    resize_reused(code, outer.nbr.len(), 0);
+    let mut code = vec![0u8; outer.nbr.len()];
     // Each row's kept entries at its end, summed into offsets below.
     let mut offsets = vec![0u32; n + 1];
     let blocks = blocks_of(n);
@@ -214,5 +211,5 @@ pub(super) fn select_codes(
     for i in 0..n {
         offsets[i + 1] += offsets[i];
     }
-    offsets
+    (code, offsets)
 }

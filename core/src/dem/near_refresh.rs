@@ -74,8 +74,7 @@ impl NearList {
         let n = outer.offsets.len().saturating_sub(1);
         assert!(x.len() == n && self.list.offsets.len() == n + 1, "near list of another list");
         // A selection code per Verlet-list entry, held only while the refresh runs.
-        let mut code = Vec::new();
-        let new_off = select_codes(outer, x, diameter, gap, Histories::Near(self), &mut code);
+        let (code, new_off) = select_codes(outer, x, diameter, gap, Histories::Near(self));
         let l = &mut self.list;
         let old_off = std::mem::take(&mut l.offsets);
         let new_total = new_off[n] as usize;

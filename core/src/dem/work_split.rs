@@ -217,12 +217,9 @@ impl Scratch {
 /// `cuts` with every chunk longer than `MAX_CHUNK_ROWS` rows cut into equal parts that are not
 /// (a plan of a bed past 4 × 65,536 particles, or one from a checkpoint).
 fn rows_capped(cuts: Vec<usize>) -> Vec<usize> {
-    if cuts.windows(2).all(|c| c[1] - c[0] <= MAX_CHUNK_ROWS) {
-        return cuts;
-    }
     let mut out = vec![cuts[0]];
     for c in cuts.windows(2) {
-        let parts = (c[1] - c[0]).div_ceil(MAX_CHUNK_ROWS).max(1);
+        let parts = (c[1] - c[0]).div_ceil(MAX_CHUNK_ROWS).max(1); // an empty chunk stays one
         out.extend((1..=parts).map(|p| c[0] + (c[1] - c[0]) * p / parts));
     }
     out
