@@ -3,6 +3,7 @@
 
 use super::contact::V3;
 use super::system::DemSystem;
+use super::verlet_list::ListRows;
 
 impl DemSystem {
     /// Verlet-list builds and near-list refreshes (without a build) so far.
@@ -15,7 +16,7 @@ impl DemSystem {
     }
     /// Entries of the Verlet list and of the near list now.
     pub fn list_sizes(&self) -> (usize, usize) {
-        (self.outer.nbr.len(), self.near.list.nbr.len())
+        (self.outer.entries(), self.near.list.nbr.len())
     }
     /// Particle pairs touching at the last step; `None` without friction (no contact flags are
     /// kept then). For diagnostics.

@@ -7,6 +7,7 @@ use super::id_histories::IdHistories;
 use super::near_list::Histories;
 use super::neighbors::{build_list, cell_order};
 use super::system::DemSystem;
+use super::verlet_list::VerletList;
 use super::walls::WallList;
 
 impl DemSystem {
@@ -57,7 +58,7 @@ impl DemSystem {
         // The old near list's storage takes the new one (its histories are carried by now).
         let hist = Histories::Carried(&carried, &self.ids);
         self.near.select_into(&nl, &self.x, diameter, self.p.near_gap(), hist);
-        self.outer = nl;
+        self.outer = VerletList::from(nl);
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc.bounds.clear(); // replanned for the new list at the next step

@@ -52,6 +52,7 @@ mod steal_ranges;
 mod step;
 mod system;
 mod team_step;
+mod verlet_list;
 mod walls;
 mod work_split;
 

@@ -16,6 +16,7 @@
 use super::contact::V3;
 use super::id_histories::IdHistories;
 use super::neighbors::NeighborList;
+use super::verlet_list::ListRows;
 use crate::buffers::resize_reused;
 use rayon::prelude::*;
 
@@ -70,7 +71,7 @@ impl NearList {
     /// The entries of `outer` with gap < `gap` at positions `x`, or with a live history (whose
     /// history and flag come along), in `outer`'s order.
     #[cfg(test)]
-    pub fn select(outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) -> NearList {
+    pub fn select(outer: &impl ListRows, x: &[V3], diameter: f64, gap: f64, hist: Histories) -> NearList {
         let mut out = NearList::default();
         out.select_into(outer, x, diameter, gap, hist);
         out
@@ -82,11 +83,12 @@ impl NearList {
     /// history; none under `Histories::Near`) or `TAKE_OLD` (with the history of the old near
     /// entry of the same partner, found again in sweep 2 by walking the old row beside the list
     /// row). Two parallel sweeps: codes and row offsets, then the rows copied into place.
-    pub fn select_into(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64, hist: Histories) {
-        let n = outer.offsets.len().saturating_sub(1);
-        let total_in = outer.nbr.len();
+    pub fn select_into(&mut self, outer: &impl ListRows, x: &[V3], diameter: f64, gap: f64, hist: Histories) {
+        let off_in = outer.offsets();
+        let n = off_in.len().saturating_sub(1);
+        let total_in = outer.entries();
         assert!(x.len() == n, "one position per list row");
-        assert!(outer.offsets.last().is_none_or(|&o| o as usize == total_in), "list offsets");
+        assert!(off_in.last().is_none_or(|&o| o as usize == total_in), "list offsets");
         let empty = NearList::default();
         let (old, carried) = match hist {
             Histories::Near(old) => {
@@ -126,18 +128,17 @@ impl NearList {
                 // Cursor over the old near row i, as in sweep 1.
                 let (mut p, p_end) =
                     if from_old { (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize) } else { (0, 0) };
-                let row = outer.offsets[i] as usize..outer.offsets[i + 1] as usize;
+                let row = off_in[i] as usize..off_in[i + 1] as usize;
                 for (k, &c) in row.clone().zip(&code[row]) {
-                    let matched = p < p_end && old.list.nbr[p] == outer.nbr[k];
+                    let j = outer.partner(i, k);
+                    let matched = p < p_end && old.list.nbr[p] == j;
                     if c != SKIP {
                         let (sh, to) = match (c, carried) {
-                            (TAKE, Some((h, ids))) => {
-                                h.get(ids[i], ids[outer.nbr[k] as usize]).map_or(([0.0; 3], 0), |s| (s, 1))
-                            }
+                            (TAKE, Some((h, ids))) => h.get(ids[i], ids[j as usize]).map_or(([0.0; 3], 0), |s| (s, 1)),
                             (TAKE, None) => ([0.0; 3], 0),
                             _ => (old.list.shear[p], old.list.touch[p]),
                         };
-                        (nbr[e], shear[e], touch[e]) = (outer.nbr[k], sh, to);
+                        (nbr[e], shear[e], touch[e]) = (j, sh, to);
                         e += 1;
                     }
                     p += matched as usize;
@@ -156,7 +157,7 @@ pub(super) fn blocks_of(n: usize) -> Vec<std::ops::Range<usize>> {
 /// `TAKE`, or `TAKE_OLD` where the old near list of `hist` has the entry), and the offsets of the
 /// new list's rows (the kept entries counted, then summed in place). Reads the old near list only.
 pub(super) fn select_codes(
-    outer: &NeighborList,
+    outer: &impl ListRows,
     x: &[V3],
     diameter: f64,
     gap: f64,
@@ -166,13 +167,14 @@ pub(super) fn select_codes(
         Histories::Near(old) => (Some(old), None),
         Histories::Carried(h, ids) => (None, Some((h, ids))),
     };
-    let n = outer.offsets.len().saturating_sub(1);
+    let off = outer.offsets();
+    let n = off.len().saturating_sub(1);
     let reach2 = (diameter + gap) * (diameter + gap);
-    let mut code = vec![0u8; outer.nbr.len()];
+    let mut code = vec![0u8; outer.entries()];
     // Each row's kept entries at its end, summed into offsets below.
     let mut offsets = vec![0u32; n + 1];
     let blocks = blocks_of(n);
-    let entries = |r: &std::ops::Range<usize>| outer.offsets[r.start] as usize..outer.offsets[r.end] as usize;
+    let entries = |r: &std::ops::Range<usize>| off[r.start] as usize..off[r.end] as usize;
     let mut work = Vec::with_capacity(blocks.len());
     let (mut crest, mut nrest) = (&mut code[..], &mut offsets[1..]);
     for r in &blocks {
@@ -182,7 +184,7 @@ pub(super) fn select_codes(
         work.push((r.clone(), c0, n0));
     }
     work.into_par_iter().for_each(|(r, codes, cnt)| {
-        let base = outer.offsets[r.start] as usize;
+        let base = off[r.start] as usize;
         for i in r.clone() {
             let xi = x[i];
             // Cursor over the old near row i, a subsequence of the list row.
@@ -190,14 +192,15 @@ pub(super) fn select_codes(
                 Some(old) => (old.list.offsets[i] as usize, old.list.offsets[i + 1] as usize),
                 None => (0, 0),
             };
-            for k in outer.offsets[i] as usize..outer.offsets[i + 1] as usize {
-                let matched = p < p_end && old.is_some_and(|o| o.list.nbr[p] == outer.nbr[k]);
+            for k in off[i] as usize..off[i + 1] as usize {
+                let j = outer.partner(i, k);
+                let matched = p < p_end && old.is_some_and(|o| o.list.nbr[p] == j);
                 let live = match (old, carried) {
                     (Some(o), _) => matched && o.list.touch[p] != 0,
-                    (None, Some((h, ids))) => h.get(ids[i], ids[outer.nbr[k] as usize]).is_some(),
+                    (None, Some((h, ids))) => h.get(ids[i], ids[j as usize]).is_some(),
                     (None, None) => false,
                 };
-                let xj = x[outer.nbr[k] as usize];
+                let xj = x[j as usize];
                 let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
                 let take = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] < reach2 || live;
                 let c = if matched { TAKE_OLD } else { TAKE };

@@ -14,7 +14,8 @@
 
 use super::contact::V3;
 use super::near_list::{select_codes, Histories, NearList, SKIP, TAKE};
-use super::neighbors::{Hist, NeighborList};
+use super::neighbors::Hist;
+use super::verlet_list::ListRows;
 use rayon::prelude::*;
 use std::collections::VecDeque;
 
@@ -58,20 +59,20 @@ struct Part<'a> {
 impl NearList {
     /// Redraw this list, drawn from `outer` before, from `outer` at positions `x` in its own
     /// storage: the same entries, histories and flags as `select_into` with `Histories::Near`.
-    pub fn refresh(&mut self, outer: &NeighborList, x: &[V3], diameter: f64, gap: f64) {
+    pub fn refresh(&mut self, outer: &impl ListRows, x: &[V3], diameter: f64, gap: f64) {
         self.refresh_in_parts(outer, x, diameter, gap, PART_ROWS);
     }
 
     /// `refresh` with parts of `part_rows` rows (tests cut small parts).
     pub(super) fn refresh_in_parts(
         &mut self,
-        outer: &NeighborList,
+        outer: &impl ListRows,
         x: &[V3],
         diameter: f64,
         gap: f64,
         part_rows: usize,
     ) {
-        let n = outer.offsets.len().saturating_sub(1);
+        let n = outer.offsets().len().saturating_sub(1);
         assert!(x.len() == n && self.list.offsets.len() == n + 1, "near list of another list");
         // A selection code per Verlet-list entry, held only while the refresh runs.
         let (code, new_off) = select_codes(outer, x, diameter, gap, Histories::Near(self));
@@ -134,7 +135,7 @@ fn part_cuts(old_off: &[u32], new_off: &[u32], part_rows: usize) -> Vec<std::ops
 }
 
 /// The rows of one part moved to their new places (module comment).
-fn redraw_part(mut part: Part, outer: &NeighborList, code: &[u8], old_off: &[u32], new_off: &[u32]) {
+fn redraw_part(mut part: Part, outer: &impl ListRows, code: &[u8], old_off: &[u32], new_off: &[u32]) {
     let r = part.rows.clone();
     let (oa, na) = (old_off[r.start] as usize, new_off[r.start] as usize);
     let own_end = old_off[r.end] as usize;
@@ -158,12 +159,13 @@ fn redraw_part(mut part: Part, outer: &NeighborList, code: &[u8], old_off: &[u32
         // The new row, as `select_into`'s sweep 2 makes it from the old one.
         new_row.clear();
         let mut q = 0;
-        let row = outer.offsets[i] as usize..outer.offsets[i + 1] as usize;
+        let row = outer.offsets()[i] as usize..outer.offsets()[i + 1] as usize;
         for (k, &c) in row.clone().zip(&code[row]) {
-            let matched = q < old_row.len() && old_row[q].0 == outer.nbr[k];
+            let j = outer.partner(i, k);
+            let matched = q < old_row.len() && old_row[q].0 == j;
             if c != SKIP {
                 let (sh, to) = if c == TAKE { ([0.0; 3], 0) } else { (old_row[q].1, old_row[q].2) };
-                new_row.push((outer.nbr[k], sh, to));
+                new_row.push((j, sh, to));
             }
             q += matched as usize;
         }

@@ -6,8 +6,8 @@ use super::contact::V3;
 use super::forces::{Past, Scratch};
 use super::kernel::Kernel;
 use super::near_list::NearList;
-use super::neighbors::NeighborList;
 use super::reference::RefPositions;
+use super::verlet_list::VerletList;
 use super::walls::WallList;
 use super::DemParams;
 use crate::case::Case;
@@ -31,7 +31,7 @@ pub struct DemSystem {
     pub(super) ids: Vec<u32>,
     /// The Verlet list (cutoff `p.cutoff`; its history arrays are emptied once the near list is
     /// drawn) and the near list drawn from it, which holds the live contact histories.
-    pub(super) outer: NeighborList,
+    pub(super) outer: VerletList,
     pub(super) near: NearList,
     pub(super) walls: WallList,
     /// Derivative levels held for the multistep scheme: 0 → Heun next, 2 → AB2, 3 → AB3.
@@ -91,7 +91,7 @@ impl DemSystem {
             x_near: RefPositions::default(),
             ext: Vec::new(),
             ids: (0..n as u32).collect(),
-            outer: NeighborList::default(),
+            outer: VerletList::default(),
             near: NearList::default(),
             walls: WallList::default(),
             levels: 0,
