@@ -3,7 +3,7 @@
 //! Prints the single-thread and rayon figures; the last line is the one quoted.
 
 use fluidbed_core::case::{Case, Gas};
-use fluidbed_core::cfd::GasSolver;
+use fluidbed_core::cfd::{GasSolver, PARALLEL_MIN_CELLS};
 use fluidbed_core::grid::CylGrid;
 use std::time::Instant;
 
@@ -55,7 +55,7 @@ pub fn run() {
     let (_, par) = time(true, batches, steps);
     let threads = rayon::current_num_threads();
     println!("{{\"bench\":\"cfd_rayon\",\"cells\":{n},\"threads\":{threads},\"ns_per_cell_step\":{par:.1}}}");
-    // The solver's default (parallel from 1,000 cells) is the figure quoted.
-    let best = if n >= 1_000 { par } else { serial };
+    // The solver's default (parallel from PARALLEL_MIN_CELLS cells) is the figure quoted.
+    let best = if n >= PARALLEL_MIN_CELLS { par } else { serial };
     println!("{{\"bench\":\"cfd\",\"cells\":{n},\"ns_per_cell_step\":{best:.1}}}");
 }

@@ -100,6 +100,6 @@ pub use mass_budget::{MassBalance, MassBudget};
 pub use params::{GasParams, Outlet, TimeScheme};
 pub use rhs::FACE_FLUX_RATE;
 pub use smart::smart_face;
-pub use solver::GasSolver;
+pub use solver::{GasSolver, PARALLEL_MIN_CELLS};
 pub use stability::{case_stable_time_step, cell_stable_dt};
 pub use voidage_ramp::VoidageRamp;

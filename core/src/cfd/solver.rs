@@ -99,8 +99,10 @@ pub struct GasSolver {
 /// What the face pressures of `pressure_gradient_cyl` read of a cell: p, β/ε² and εu (Cartesian).
 type FaceInputs = (f64, f64, [f64; 3]);
 
-/// Below this many cells the layers are processed on one thread (rayon's overhead dominates).
-const PARALLEL_MIN_CELLS: usize = 1_000;
+/// Below this many cells the layers are processed on one thread (the team's hand-offs cost more
+/// than they share). `bench -- cfd` on 2 threads, ns per cell-step serial / team: 82 / 114 at 81
+/// cells, 68 / 60 at 324, 64 / 50 at 729, 63 / 45 at 1,296 (docs/BENCHMARKS.md, "Scaling").
+pub const PARALLEL_MIN_CELLS: usize = 300;
 
 impl GasSolver {
     /// Gas at rest, hydrostatic about `outlet_pressure_pa` at z = height, ε = 1 until set.
