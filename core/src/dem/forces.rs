@@ -55,7 +55,7 @@ impl Past {
     /// Particle i now is particle order[i] before.
     pub fn permute(&mut self, order: &[u32]) {
         for s in self.v.iter_mut().chain(&mut self.a).chain(&mut self.alpha) {
-            *s = order.iter().map(|&o| s[o as usize]).collect();
+            *s = order.par_iter().map(|&o| s[o as usize]).collect();
         }
     }
 }

@@ -5,10 +5,11 @@
 use super::contact::V3;
 use super::id_histories::IdHistories;
 use super::near_list::Histories;
-use super::neighbors::{build_list, cell_order};
+use super::neighbors::cell_order;
 use super::system::DemSystem;
 use super::verlet_list::VerletList;
 use super::walls::WallList;
+use rayon::prelude::*;
 
 impl DemSystem {
     /// Redraw the near list from the Verlet list, rebuilding that first if a particle has moved
@@ -41,7 +42,7 @@ impl DemSystem {
     /// draw the near list.
     pub(super) fn rebuild(&mut self) {
         let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
-        let perm = |src: &Vec<V3>| -> Vec<V3> { order.iter().map(|&o| src[o as usize]).collect() };
+        let perm = |src: &Vec<V3>| -> Vec<V3> { order.par_iter().map(|&o| src[o as usize]).collect() };
         self.x = perm(&self.x);
         self.v = perm(&self.v);
         self.w = perm(&self.w);
@@ -50,15 +51,15 @@ impl DemSystem {
         }
         self.past.permute(&order);
         let old_ids = std::mem::take(&mut self.ids);
-        self.ids = order.iter().map(|&o| old_ids[o as usize]).collect();
+        self.ids = order.par_iter().map(|&o| old_ids[o as usize]).collect();
         let diameter = 2.0 * self.p.radius;
         self.outer = Default::default(); // the old list is not read again
-        let nl = build_list(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
+        let outer = VerletList::build(&self.x, self.p.tube_radius, self.p.cutoff, diameter);
         let carried = if self.p.friction { IdHistories::of(&self.near.list, &old_ids) } else { Default::default() };
         // The old near list's storage takes the new one (its histories are carried by now).
         let hist = Histories::Carried(&carried, &self.ids);
-        self.near.select_into(&nl, &self.x, diameter, self.p.near_gap(), hist);
-        self.outer = VerletList::from(nl);
+        self.near.select_into(&outer, &self.x, diameter, self.p.near_gap(), hist);
+        self.outer = outer;
         let had_walls = !self.x_build.is_empty();
         self.walls = WallList::build(&self.p, &self.x, &self.walls, had_walls.then_some(&order[..]));
         self.sc.bounds.clear(); // replanned for the new list at the next step

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Particles per work block of the list build (fixed, so results do not depend on threads).
-const BLOCK: usize = 256;
+pub(super) const BLOCK: usize = 256;
 
 /// A contact history ξ as stored: single precision, what the pair law (`pair_batch::lanes`)
 /// computes it in, so storing it so loses nothing and halves the bytes the pair pass streams.
@@ -29,7 +29,7 @@ pub struct NeighborList {
 /// Cell order of the particles: the permutation that sorts them by linked cell (stable).
 pub fn cell_order(x: &[[f64; 3]], tube_radius: f64, cell: f64) -> Vec<u32> {
     let grid = CellGrid::new(x, tube_radius, cell);
-    let cells: Vec<u32> = x.iter().map(|p| grid.cell_of(p) as u32).collect();
+    let cells: Vec<u32> = x.par_iter().map(|p| grid.cell_of(p) as u32).collect();
     let mut count = vec![0u32; grid.len() + 1];
     for &c in &cells {
         count[c as usize + 1] += 1;
@@ -85,10 +85,28 @@ impl CellGrid {
 
 /// Build the half list for particles already sorted by cell (`x` in cell order), pairs closer
 /// than `cutoff`, each row sorted by the gap to contact (centre distance − `diameter`).
+#[cfg(test)]
 pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) -> NeighborList {
+    let rows = build_rows(x, tube_radius, cutoff, diameter);
+    let mut offsets = Vec::with_capacity(x.len() + 1);
+    offsets.push(0u32);
+    let total: usize = rows.iter().map(|r| r.1.len()).sum();
+    let mut nbr = Vec::with_capacity(total);
+    for (counts, list) in rows {
+        for c in counts {
+            offsets.push(offsets.last().unwrap() + c);
+        }
+        nbr.extend_from_slice(&list);
+    }
+    NeighborList { offsets, nbr, shear: Vec::new(), touch: Vec::new() }
+}
+
+/// The rows of `build_list` per block of BLOCK particles, in block order: each row's length and
+/// the block's partners.
+pub fn build_rows(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) -> Vec<(Vec<u32>, Vec<u32>)> {
     let grid = CellGrid::new(x, tube_radius, cutoff);
     let ncell = grid.len();
-    let cells: Vec<usize> = x.iter().map(|p| grid.cell_of(p)).collect();
+    let cells: Vec<usize> = x.par_iter().map(|p| grid.cell_of(p)).collect();
     let mut start = vec![0u32; ncell + 1];
     for &c in &cells {
         start[c + 1] += 1;
@@ -99,7 +117,7 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
     let c2 = cutoff * cutoff;
     let [nx, ny, nz] = grid.n;
     // Rows built per block in parallel, concatenated in block order.
-    let rows: Vec<(Vec<u32>, Vec<u32>)> = (0..x.len().div_ceil(BLOCK))
+    (0..x.len().div_ceil(BLOCK))
         .into_par_iter()
         .map(|b| {
             let (a, e) = (b * BLOCK, ((b + 1) * BLOCK).min(x.len()));
@@ -149,16 +167,5 @@ pub fn build_list(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) 
             }
             (counts, list)
         })
-        .collect();
-    let mut offsets = Vec::with_capacity(x.len() + 1);
-    offsets.push(0u32);
-    let total: usize = rows.iter().map(|r| r.1.len()).sum();
-    let mut nbr = Vec::with_capacity(total);
-    for (counts, list) in rows {
-        for c in counts {
-            offsets.push(offsets.last().unwrap() + c);
-        }
-        nbr.extend_from_slice(&list);
-    }
-    NeighborList { offsets, nbr, shear: Vec::new(), touch: Vec::new() }
+        .collect()
 }

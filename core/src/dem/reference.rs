@@ -25,7 +25,7 @@ impl RefPositions {
     /// Store `x` (reusing the storage).
     pub fn store(&mut self, x: &[V3]) {
         self.x.clear();
-        self.x.extend(x.iter().map(|&p| narrow(p)));
+        self.x.par_extend(x.par_iter().map(|&p| narrow(p)));
         self.err = rounding_bound(&self.x);
     }
     pub fn is_empty(&self) -> bool {

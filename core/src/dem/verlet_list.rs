@@ -6,7 +6,8 @@
 //! pass. A checkpoint holds the plain list's shape (`NeighborList`), so checkpoints of either
 //! form resume.
 
-use super::neighbors::{Hist, NeighborList};
+use super::neighbors::{build_rows, Hist, NeighborList, BLOCK};
+use rayon::prelude::*;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// CSR rows of partners, as the near list's selection reads them.
@@ -73,6 +74,48 @@ impl From<NeighborList> for VerletList {
 }
 
 impl VerletList {
+    /// The list of `build_rows` (particles in cell order, pairs closer than `cutoff`), its blocks
+    /// assembled in parallel.
+    pub fn build(x: &[[f64; 3]], tube_radius: f64, cutoff: f64, diameter: f64) -> VerletList {
+        Self::assemble(build_rows(x, tube_radius, cutoff, diameter), u16::MAX as usize)
+    }
+
+    /// The list of `rows` (`build_rows`), as steps if none exceeds `max_step` (≤ u16::MAX).
+    fn assemble(rows: Vec<(Vec<u32>, Vec<u32>)>, max_step: usize) -> VerletList {
+        let n: usize = rows.iter().map(|r| r.0.len()).sum();
+        let mut offsets = Vec::with_capacity(n + 1);
+        offsets.push(0u32);
+        for c in rows.iter().flat_map(|r| &r.0) {
+            offsets.push(offsets.last().unwrap() + c);
+        }
+        // Block b holds rows b·BLOCK.. and entries offsets[b·BLOCK]..
+        let fits = rows.par_iter().enumerate().all(|(b, (counts, list))| {
+            let owners = (b * BLOCK..).zip(counts).flat_map(|(i, &c)| std::iter::repeat_n(i, c as usize));
+            owners.zip(list).all(|(i, &j)| (j as usize).checked_sub(i).is_some_and(|s| s <= max_step))
+        });
+        let total = *offsets.last().unwrap() as usize;
+        if !fits || total == 0 {
+            let mut wide = Vec::with_capacity(total);
+            rows.iter().for_each(|r| wide.extend_from_slice(&r.1));
+            return VerletList { offsets, step: Vec::new(), wide };
+        }
+        let mut step = vec![0u16; total];
+        let mut parts = Vec::with_capacity(rows.len());
+        let mut rest = &mut step[..];
+        for r in &rows {
+            let (part, more) = std::mem::take(&mut rest).split_at_mut(r.1.len());
+            parts.push(part);
+            rest = more;
+        }
+        parts.into_par_iter().zip(rows.par_iter()).enumerate().for_each(|(b, (out, (counts, list)))| {
+            let owners = (b * BLOCK..).zip(counts).flat_map(|(i, &c)| std::iter::repeat_n(i, c as usize));
+            for ((o, i), &j) in out.iter_mut().zip(owners).zip(list) {
+                *o = (j as usize - i) as u16;
+            }
+        });
+        VerletList { offsets, step, wide: Vec::new() }
+    }
+
     /// The plain list (partners as u32, no histories).
     #[cfg(test)]
     pub fn to_list(&self) -> NeighborList {
@@ -152,6 +195,35 @@ mod tests {
         let back = v.to_list();
         assert_eq!((back.offsets, back.nbr), (nl.offsets.clone(), nl.nbr.clone()));
         assert_eq!(v.partner(2, 4), 65_537);
+    }
+
+    #[test]
+    fn a_built_list_is_the_plain_list_in_either_form() {
+        // A random bed in cell order, as the DEM builds it.
+        let mut seed = 7u64;
+        let mut u = || {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let (r, d) = (0.01, 0.001);
+        let raw: Vec<[f64; 3]> = (0..6000)
+            .map(|_| {
+                let (a, s) = (std::f64::consts::TAU * u(), (r - d / 2.0) * u().sqrt());
+                [s * a.cos(), s * a.sin(), 0.02 * u()]
+            })
+            .collect();
+        let order = crate::dem::neighbors::cell_order(&raw, r, 1.4 * d);
+        let x: Vec<[f64; 3]> = order.iter().map(|&o| raw[o as usize]).collect();
+        let plain = crate::dem::neighbors::build_list(&x, r, 1.4 * d, d);
+        assert!(plain.nbr.len() > 10_000, "{} pairs", plain.nbr.len());
+        let compact = VerletList::build(&x, r, 1.4 * d, d);
+        let wide = VerletList::assemble(build_rows(&x, r, 1.4 * d, d), 3);
+        assert!(compact.is_compact() && !wide.is_compact());
+        for v in [compact, wide] {
+            let back = v.to_list();
+            assert!(back.offsets == plain.offsets && back.nbr == plain.nbr);
+            assert_eq!(v.entries(), plain.nbr.len());
+        }
     }
 
     #[test]

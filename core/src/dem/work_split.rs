@@ -148,11 +148,12 @@ impl Scratch {
         // Chunk c ends where the work reaches (c+1)/nc of the total, so that the chunks take
         // about the same time: one unit per particle and per list entry, TOUCH_WEIGHT more per
         // pair that touched in the last step (the flags; all zero before the first step).
-        let mut touched = Vec::with_capacity(n + 1);
-        touched.push(0);
+        let mut touched = vec![0usize; n + 1];
+        touched[1..].par_iter_mut().enumerate().for_each(|(i, t)| {
+            *t = nl.touch[nl.offsets[i] as usize..nl.offsets[i + 1] as usize].iter().map(|&f| f as usize).sum();
+        });
         for i in 0..n {
-            let row = &nl.touch[nl.offsets[i] as usize..nl.offsets[i + 1] as usize];
-            touched.push(touched[i] + row.iter().map(|&f| f as usize).sum::<usize>());
+            touched[i + 1] += touched[i];
         }
         let work = |i: usize| nl.offsets[i] as usize + i + TOUCH_WEIGHT * touched[i];
         let cut = |c: usize| {
@@ -208,7 +209,8 @@ impl Scratch {
         for (c, &[a, _, e]) in bounds.iter().enumerate() {
             start.push(start[c] + e - a);
         }
-        acc.clear();
+        // Rows kept from the last plan are not cleared: each chunk zeroes its rows before its
+        // pass (`forces::chunk_pairs`), and nothing reads them before that.
         resize_reused(&mut acc, start[nc], PairSum::default());
         (self.bounds, self.start, self.acc, self.owner) = (bounds, start, acc, owner);
     }
