@@ -52,11 +52,9 @@ impl Past {
         let z = || [vec![[0.0; 3]; n], vec![[0.0; 3]; n]];
         Past { v: z(), a: z(), alpha: z() }
     }
-    /// Particle i now is particle order[i] before.
-    pub fn permute(&mut self, order: &[u32]) {
-        for s in self.v.iter_mut().chain(&mut self.a).chain(&mut self.alpha) {
-            *s = order.par_iter().map(|&o| s[o as usize]).collect();
-        }
+    /// The six slots (v, a, α; two each).
+    pub fn slots_mut(&mut self) -> impl Iterator<Item = &mut Vec<PastV3>> {
+        self.v.iter_mut().chain(&mut self.a).chain(&mut self.alpha)
     }
 }
 

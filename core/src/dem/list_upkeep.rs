@@ -2,7 +2,6 @@
 //! Verlet list, the Verlet list rebuilt (with a re-sort by cell and the contact histories
 //! carried by particle id) when a particle could have moved past its skin (`near_list`).
 
-use super::contact::V3;
 use super::id_histories::IdHistories;
 use super::near_list::Histories;
 use super::neighbors::cell_order;
@@ -42,14 +41,18 @@ impl DemSystem {
     /// draw the near list.
     pub(super) fn rebuild(&mut self) {
         let order = cell_order(&self.x, self.p.tube_radius, self.p.cutoff);
-        let perm = |src: &Vec<V3>| -> Vec<V3> { order.par_iter().map(|&o| src[o as usize]).collect() };
-        self.x = perm(&self.x);
-        self.v = perm(&self.v);
-        self.w = perm(&self.w);
-        if !self.ext.is_empty() {
-            self.ext = perm(&self.ext);
+        // Each array is gathered into the storage the previous one left, not into fresh pages
+        // (which fault in at first touch: docs/BENCHMARKS.md, "Scaling", Decisions).
+        let mut spare = Vec::new();
+        for a in [&mut self.x, &mut self.v, &mut self.w, &mut self.ext] {
+            if !a.is_empty() {
+                permuted(a, &order, &mut spare);
+            }
         }
-        self.past.permute(&order);
+        let mut spare = Vec::new();
+        for s in self.past.slots_mut() {
+            permuted(s, &order, &mut spare);
+        }
         let old_ids = std::mem::take(&mut self.ids);
         self.ids = order.par_iter().map(|&o| old_ids[o as usize]).collect();
         let diameter = 2.0 * self.p.radius;
@@ -69,4 +72,12 @@ impl DemSystem {
         self.rebuild_due = false;
         self.builds.0 += 1;
     }
+}
+
+/// `a` in the order `order` (a[i] becomes the old a[order[i]]), gathered into `spare`'s storage;
+/// `spare` takes the old storage.
+fn permuted<T: Copy + Send + Sync>(a: &mut Vec<T>, order: &[u32], spare: &mut Vec<T>) {
+    spare.clear();
+    spare.par_extend(order.par_iter().map(|&o| a[o as usize]));
+    std::mem::swap(a, spare);
 }
