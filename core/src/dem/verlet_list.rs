@@ -1,4 +1,4 @@
-//! The Verlet list as the DEM keeps it between builds: the rows of `build_list` (partners j > i,
+//! The Verlet list as the DEM keeps it between builds: the rows of `build_rows` (partners j > i,
 //! CSR) with each partner stored as j − i in 16 bits when every row's partners lie within 65,535
 //! rows of it, else as the plain u32. The cell order puts a particle's partners within about two
 //! layers of linked cells (about 13,000 rows in a 205k-particle bed), so 2 B per entry instead of
