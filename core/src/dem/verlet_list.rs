@@ -58,18 +58,18 @@ impl ListRows for VerletList {
 }
 
 impl From<NeighborList> for VerletList {
-    /// The rows of `nl` (its histories and flags are not kept).
+    /// The rows of `nl` (its histories and flags are not kept), in `build_rows`' blocks.
     fn from(nl: NeighborList) -> VerletList {
         let NeighborList { offsets, nbr, .. } = nl;
-        let rows =
-            || (0..offsets.len().saturating_sub(1)).flat_map(|i| (offsets[i]..offsets[i + 1]).map(move |k| (i, k)));
-        let fits = rows().all(|(i, k)| nbr[k as usize].checked_sub(i as u32).is_some_and(|s| s <= u16::MAX as u32));
-        if fits && !nbr.is_empty() {
-            let step = rows().map(|(i, k)| (nbr[k as usize] - i as u32) as u16).collect();
-            VerletList { offsets, step, wide: Vec::new() }
-        } else {
-            VerletList { offsets, step: Vec::new(), wide: nbr }
-        }
+        let n = offsets.len().saturating_sub(1);
+        let rows = (0..n.div_ceil(BLOCK))
+            .map(|b| {
+                let (a, e) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+                let counts = offsets[a..=e].windows(2).map(|o| o[1] - o[0]).collect();
+                (counts, nbr[offsets[a] as usize..offsets[e] as usize].to_vec())
+            })
+            .collect();
+        Self::assemble(rows, u16::MAX as usize)
     }
 }
 
