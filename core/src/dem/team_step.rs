@@ -68,10 +68,10 @@ pub(crate) fn team_step<const FR: bool>(
     let (bounds, start, owner) = (&sc.bounds[..], &sc.start[..], &sc.owner[..]);
     assert!(start.len() > bounds.len() && bounds.iter().all(|&[a, b, e]| a <= b && b <= e && e <= n), "chunks");
     // What the threads write must be disjoint: chunk c writes list entries offsets[a]..offsets[b]
-    // and buffer rows start[c]..start[c] + e − a, so the chunks must follow each other. (The
-    // offsets are checked at the chunk cuts only: a pass over all of them here, on one thread
-    // before the team starts, let the other threads fall asleep at every step; the plan checks
-    // them all, `Scratch::replan`, and the list changes only with a new plan.)
+    // and buffer rows start[c]..start[c] + e − a, so the chunks must follow each other. The
+    // offsets are checked at the chunk cuts only: a pass over all of them here, on one thread,
+    // would idle the others long enough to sleep; `Scratch::replan` checks them all, and the list
+    // changes only with a new plan.
     assert!(offsets.len() == n + 1 && bounds.iter().all(|&[a, b, _]| offsets[a] <= offsets[b]), "list offsets");
     assert!(bounds.windows(2).all(|c| c[0][1] == c[1][0]), "chunks in order");
     assert!(bounds.iter().enumerate().all(|(c, &[a, _, e])| start[c] + e - a <= start[c + 1]), "chunk buffers");
